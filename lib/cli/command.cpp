@@ -1,0 +1,296 @@
+#include "cli/command.hpp"
+
+#include <signal.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <sstream>
+
+#include "common/error.hpp"
+
+#ifndef QTE_VERSION
+#define QTE_VERSION "unknown"
+#endif
+
+namespace qte::cli {
+namespace {
+
+// Options every tool has, appended to the tool's own.
+std::vector<OptionSpec> common_options(const Usage& usage) {
+  return {
+      {"seed", "N",
+       usage.uses_randomness
+           ? "seed of every random choice this tool makes; same inputs and seed give the same "
+             "output bytes"
+           : "accepted for uniform pipelines; this tool makes no random choices",
+       "0"},
+      {"help", "", "print this help and exit", ""},
+      {"help-man", "", "print this help as a man page (roff) and exit", ""},
+      {"version", "", "print the toolkit version and exit", ""},
+  };
+}
+
+std::vector<OptionSpec> all_options(const Usage& usage) {
+  std::vector<OptionSpec> options = usage.options;
+  for (auto& o : common_options(usage)) options.push_back(o);
+  return options;
+}
+
+const OptionSpec* find_option(const std::vector<OptionSpec>& options, const std::string& name) {
+  for (const auto& o : options)
+    if (o.name == name) return &o;
+  return nullptr;
+}
+
+std::string synopsis(const Usage& usage) {
+  std::string s = usage.name + " [OPTIONS]";
+  for (const auto& a : usage.arguments) {
+    std::string arg = a.name + (a.variadic ? "..." : "");
+    s += " " + (a.optional ? "[" + arg + "]" : arg);
+  }
+  return s;
+}
+
+std::string option_label(const OptionSpec& o) {
+  return "--" + o.name + (o.value_name.empty() ? "" : " " + o.value_name);
+}
+
+std::string option_help(const OptionSpec& o) {
+  std::string h = o.help;
+  if (!o.default_value.empty()) h += " (default: " + o.default_value + ")";
+  if (o.repeatable) h += "; may be repeated";
+  return h;
+}
+
+// Wraps `text` to `width` columns with `indent` spaces before every line.
+std::string wrap(const std::string& text, std::size_t indent, std::size_t width = 80) {
+  std::istringstream words(text);
+  std::string word, line, out;
+  const std::string pad(indent, ' ');
+  while (words >> word) {
+    if (!line.empty() && indent + line.size() + 1 + word.size() > width) {
+      out += pad + line + "\n";
+      line.clear();
+    }
+    line += (line.empty() ? "" : " ") + word;
+  }
+  if (!line.empty()) out += pad + line + "\n";
+  return out;
+}
+
+// Escapes text for roff: backslashes, and leading dots or quotes.
+std::string roff(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '\\') out += "\\e";
+    else if (c == '-') out += "\\-";
+    else out += c;
+  }
+  if (!out.empty() && (out[0] == '.' || out[0] == '\'')) out = "\\&" + out;
+  return out;
+}
+
+std::string upper(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
+const char* kCommonExitStatus =
+    "0 on success; 1 on an error, reported as one line on standard error naming the file, "
+    "record and byte offset where it applies; 2 on a usage error; 141 when the reader of "
+    "standard output went away (as for SIGPIPE).";
+
+}  // namespace
+
+bool Arguments::has(const std::string& name) const { return given_.count(name) > 0; }
+
+bool Arguments::flag(const std::string& name) const { return has(name); }
+
+std::string Arguments::text(const std::string& name) const {
+  auto it = given_.find(name);
+  if (it != given_.end()) return it->second.back();
+  const OptionSpec* o = find_option(all_options(*usage_), name);
+  if (!o) throw Error("internal: option --" + name + " is not declared");
+  return o->default_value;
+}
+
+int64_t Arguments::integer(const std::string& name) const {
+  const std::string v = text(name);
+  try {
+    std::size_t used = 0;
+    const long long n = std::stoll(v, &used, 0);
+    if (used == v.size()) return n;
+  } catch (const std::exception&) {
+  }
+  throw UsageError("--" + name + ": expected an integer, got '" + v + "'");
+}
+
+double Arguments::real(const std::string& name) const {
+  const std::string v = text(name);
+  try {
+    std::size_t used = 0;
+    const double x = std::stod(v, &used);
+    if (used == v.size()) return x;
+  } catch (const std::exception&) {
+  }
+  throw UsageError("--" + name + ": expected a number, got '" + v + "'");
+}
+
+std::vector<std::string> Arguments::all(const std::string& name) const {
+  auto it = given_.find(name);
+  return it == given_.end() ? std::vector<std::string>{} : it->second;
+}
+
+Arguments parse(const Usage& usage, const std::vector<std::string>& argv) {
+  Arguments args;
+  args.usage_ = &usage;
+  const auto options = all_options(usage);
+  bool options_done = false;
+  for (std::size_t i = 0; i < argv.size(); ++i) {
+    const std::string& a = argv[i];
+    if (options_done || a == "-" || a.size() < 2 || a.compare(0, 2, "--") != 0) {
+      if (!options_done && a.size() > 1 && a[0] == '-' && a != "-")
+        throw UsageError("unknown option '" + a + "' (options are --long-names)");
+      args.positional_.push_back(a);
+      continue;
+    }
+    if (a == "--") {
+      options_done = true;
+      continue;
+    }
+    std::string name = a.substr(2), value;
+    bool inline_value = false;
+    if (auto eq = name.find('='); eq != std::string::npos) {
+      value = name.substr(eq + 1);
+      name = name.substr(0, eq);
+      inline_value = true;
+    }
+    const OptionSpec* o = find_option(options, name);
+    if (!o) throw UsageError("unknown option --" + name);
+    if (o->value_name.empty()) {
+      if (inline_value) throw UsageError("--" + name + " takes no value");
+    } else if (!inline_value) {
+      if (i + 1 >= argv.size()) throw UsageError("--" + name + " needs a value " + o->value_name);
+      value = argv[++i];
+    }
+    auto& values = args.given_[name];
+    if (!values.empty() && !o->repeatable && !o->value_name.empty())
+      throw UsageError("--" + name + " given twice");
+    values.push_back(value);
+  }
+  if (args.has("help") || args.has("help-man") || args.has("version")) return args;
+  std::size_t required = 0, max = 0;
+  bool unbounded = false;
+  for (const auto& spec : usage.arguments) {
+    if (!spec.optional) ++required;
+    ++max;
+    unbounded |= spec.variadic;
+  }
+  if (args.positional_.size() < required)
+    throw UsageError("missing argument " + usage.arguments[args.positional_.size()].name);
+  if (!unbounded && args.positional_.size() > max)
+    throw UsageError("unexpected argument '" + args.positional_[max] + "'");
+  args.seed();  // validates --seed early
+  return args;
+}
+
+std::string help_text(const Usage& usage) {
+  std::string out = usage.name + " - " + usage.summary + "\n\nUsage: " + synopsis(usage) + "\n";
+  for (const auto& p : usage.description) out += "\n" + wrap(p, 2);
+  if (!usage.arguments.empty()) {
+    out += "\nArguments:\n";
+    for (const auto& a : usage.arguments) out += "  " + a.name + "\n" + wrap(a.help, 6);
+  }
+  out += "\nOptions:\n";
+  for (const auto& o : all_options(usage))
+    out += "  " + option_label(o) + "\n" + wrap(option_help(o), 6);
+  if (!usage.examples.empty()) {
+    out += "\nExamples:\n";
+    for (const auto& e : usage.examples) out += "  " + e.command + "\n" + wrap(e.explanation, 6);
+  }
+  out += "\nExit status:\n" + wrap(kCommonExitStatus, 2);
+  if (!usage.exit_status.empty()) out += wrap(usage.exit_status, 2);
+  if (!usage.see_also.empty()) {
+    out += "\nSee also:\n  ";
+    for (std::size_t i = 0; i < usage.see_also.size(); ++i)
+      out += (i ? ", " : "") + usage.see_also[i];
+    out += "\n";
+  }
+  return out;
+}
+
+std::string man_page(const Usage& usage) {
+  std::string out;
+  out += ".\\\" Generated by '" + usage.name + " --help-man'; edit the tool's usage(), not this.\n";
+  out += ".TH " + upper(usage.name) + " 1 \"\" \"QTE toolkit " QTE_VERSION "\" \"QTE toolkit\"\n";
+  out += ".SH NAME\n" + roff(usage.name) + " \\- " + roff(usage.summary) + "\n";
+  out += ".SH SYNOPSIS\n.B " + roff(synopsis(usage)) + "\n";
+  out += ".SH DESCRIPTION\n";
+  for (std::size_t i = 0; i < usage.description.size(); ++i)
+    out += (i ? ".PP\n" : "") + roff(usage.description[i]) + "\n";
+  if (!usage.arguments.empty()) {
+    out += ".SH ARGUMENTS\n";
+    for (const auto& a : usage.arguments) out += ".TP\n.I " + roff(a.name) + "\n" + roff(a.help) + "\n";
+  }
+  out += ".SH OPTIONS\n";
+  for (const auto& o : all_options(usage)) {
+    out += ".TP\n.B \\-\\-" + roff(o.name) + (o.value_name.empty() ? "" : " \\fI" + roff(o.value_name) + "\\fR") + "\n";
+    out += roff(option_help(o)) + "\n";
+  }
+  if (!usage.examples.empty()) {
+    out += ".SH EXAMPLES\n";
+    for (const auto& e : usage.examples)
+      out += ".PP\n.nf\n" + roff(e.command) + "\n.fi\n.RS\n" + roff(e.explanation) + "\n.RE\n";
+  }
+  out += ".SH EXIT STATUS\n" + roff(kCommonExitStatus) + "\n";
+  if (!usage.exit_status.empty()) out += ".PP\n" + roff(usage.exit_status) + "\n";
+  if (!usage.see_also.empty()) {
+    out += ".SH SEE ALSO\n";
+    for (std::size_t i = 0; i < usage.see_also.size(); ++i) {
+      const std::string& s = usage.see_also[i];
+      const auto paren = s.find('(');
+      out += ".BR " + roff(s.substr(0, paren)) + " " + s.substr(paren) +
+             (i + 1 < usage.see_also.size() ? " ," : "") + "\n";
+    }
+  }
+  return out;
+}
+
+int run_tool(int argc, char** argv, const Usage& usage,
+             const std::function<void(const Arguments&)>& run) {
+  // EPIPE arrives as an error from write() instead of killing the process; see BrokenPipe.
+  ::signal(SIGPIPE, SIG_IGN);
+  const std::string prefix = usage.name + ": ";
+  try {
+    const Arguments args = parse(usage, std::vector<std::string>(argv + 1, argv + argc));
+    if (args.has("help")) {
+      std::cout << help_text(usage);
+      return 0;
+    }
+    if (args.has("help-man")) {
+      std::cout << man_page(usage);
+      return 0;
+    }
+    if (args.has("version")) {
+      std::cout << usage.name << " (QTE toolkit) " << QTE_VERSION << "\n";
+      return 0;
+    }
+    run(args);
+    std::cout.flush();
+    return 0;
+  } catch (const BrokenPipe&) {
+    return 141;
+  } catch (const UsageError& e) {
+    std::cerr << prefix << e.what() << " (see " << usage.name << " --help)\n";
+    return 2;
+  } catch (const std::bad_alloc&) {
+    std::cerr << prefix << "out of memory\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << prefix << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace qte::cli

@@ -1,0 +1,76 @@
+// Every tool declares its usage once (a `Usage` value); --help, --version and the man page
+// (--help-man, checked against man/ by a test) are generated from it, so they never drift.
+// run_tool() parses the command line, runs the tool and is the one place errors are printed.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace qte::cli {
+
+struct OptionSpec {
+  std::string name;         // long name without dashes: "type" for --type
+  std::string value_name;   // "T"; empty for a flag
+  std::string help;
+  std::string default_value;  // shown in help; used when the option is absent
+  bool repeatable = false;    // may be given several times (values collected in order)
+};
+
+struct ArgumentSpec {
+  std::string name;  // "FILE"
+  std::string help;
+  bool optional = false;
+  bool variadic = false;  // takes the remaining arguments
+};
+
+struct Example {
+  std::string command;
+  std::string explanation;
+};
+
+struct Usage {
+  std::string name;     // program name, e.g. "stream-dump"
+  std::string summary;  // one line, lower case, no full stop
+  std::vector<std::string> description;  // paragraphs
+  std::vector<ArgumentSpec> arguments;
+  std::vector<OptionSpec> options;
+  std::vector<Example> examples;
+  std::vector<std::string> see_also;  // "qte-stream(5)"
+  // True when the tool draws random numbers; --seed is accepted by every tool either way.
+  bool uses_randomness = false;
+  std::string exit_status;  // extra text for EXIT STATUS; the common codes are always listed
+};
+
+class Arguments {
+ public:
+  bool flag(const std::string& name) const;
+  bool has(const std::string& name) const;  // given on the command line
+  std::string text(const std::string& name) const;
+  int64_t integer(const std::string& name) const;
+  double real(const std::string& name) const;
+  std::vector<std::string> all(const std::string& name) const;  // repeatable options
+  const std::vector<std::string>& positional() const { return positional_; }
+  uint64_t seed() const { return static_cast<uint64_t>(integer("seed")); }
+
+ private:
+  friend Arguments parse(const Usage& usage, const std::vector<std::string>& argv);
+  const Usage* usage_ = nullptr;
+  std::map<std::string, std::vector<std::string>> given_;
+  std::vector<std::string> positional_;
+};
+
+// Throws UsageError on unknown options, missing values or wrong argument counts.
+Arguments parse(const Usage& usage, const std::vector<std::string>& argv);
+
+std::string help_text(const Usage& usage);
+std::string man_page(const Usage& usage);  // roff, section 1
+
+// main() of every tool: `return run_tool(argc, argv, usage(), run);`
+// Exit status: 0 success, 1 error (one line on stderr), 2 usage error, 141 broken pipe.
+int run_tool(int argc, char** argv, const Usage& usage,
+             const std::function<void(const Arguments&)>& run);
+
+}  // namespace qte::cli

@@ -1,0 +1,123 @@
+#include "common/atomic_file.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <mutex>
+
+#include "common/error.hpp"
+
+namespace qte {
+namespace {
+
+// Temporary files of this process, unlinked by the signal handler. Fixed-size table of
+// C strings because a handler may only call async-signal-safe functions.
+constexpr int kMaxTempFiles = 64;
+char g_temp_paths[kMaxTempFiles][4096];
+volatile sig_atomic_t g_temp_used[kMaxTempFiles];
+std::mutex g_mutex;
+std::once_flag g_handlers_installed;
+
+void remove_temp_files_and_die(int signal_number) {
+  for (int i = 0; i < kMaxTempFiles; ++i)
+    if (g_temp_used[i]) ::unlink(g_temp_paths[i]);
+  ::signal(signal_number, SIG_DFL);
+  ::raise(signal_number);
+}
+
+void install_handlers() {
+  for (int s : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction action {};
+    action.sa_handler = remove_temp_files_and_die;
+    sigemptyset(&action.sa_mask);
+    ::sigaction(s, &action, nullptr);
+  }
+}
+
+int register_temp(const std::string& path) {
+  std::call_once(g_handlers_installed, install_handlers);
+  std::lock_guard<std::mutex> lock(g_mutex);
+  for (int i = 0; i < kMaxTempFiles; ++i)
+    if (!g_temp_used[i] && path.size() < sizeof g_temp_paths[i]) {
+      std::memcpy(g_temp_paths[i], path.c_str(), path.size() + 1);
+      g_temp_used[i] = 1;
+      return i;
+    }
+  return -1;  // still correct, only not cleaned up on a signal
+}
+
+void unregister_temp(const std::string& path) {
+  std::lock_guard<std::mutex> lock(g_mutex);
+  for (int i = 0; i < kMaxTempFiles; ++i)
+    if (g_temp_used[i] && path == g_temp_paths[i]) g_temp_used[i] = 0;
+}
+
+}  // namespace
+
+void write_all(int fd, const void* data, std::size_t n, const std::string& what) {
+  const auto* p = static_cast<const uint8_t*>(data);
+  while (n > 0) {
+    const ssize_t put = ::write(fd, p, n);
+    if (put < 0) {
+      if (errno == EINTR) continue;
+      if (errno == EPIPE) throw BrokenPipe();
+      throw_system_error("cannot write " + what);
+    }
+    p += put;
+    n -= static_cast<std::size_t>(put);
+  }
+}
+
+AtomicOutputFile::AtomicOutputFile(std::string path)
+    : path_(std::move(path)), temp_path_(path_ + ".tmp." + std::to_string(::getpid())) {
+  register_temp(temp_path_);
+  fd_ = ::open(temp_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd_ < 0) {
+    unregister_temp(temp_path_);
+    throw_system_error("cannot create " + path_ + " (as " + temp_path_ + ")");
+  }
+}
+
+AtomicOutputFile::~AtomicOutputFile() {
+  if (fd_ >= 0) {
+    ::close(fd_);
+    ::unlink(temp_path_.c_str());
+    unregister_temp(temp_path_);
+  }
+}
+
+void AtomicOutputFile::write(const void* data, std::size_t n) {
+  if (fd_ < 0) throw Error("write to " + path_ + " after it was committed");
+  write_all(fd_, data, n, path_);
+}
+
+void AtomicOutputFile::commit() {
+  if (fd_ < 0) return;
+  if (::fsync(fd_) != 0 && errno != EINVAL) throw_system_error("cannot sync " + path_);
+  if (::close(fd_) != 0) {
+    fd_ = -1;
+    ::unlink(temp_path_.c_str());
+    unregister_temp(temp_path_);
+    throw_system_error("cannot close " + path_);
+  }
+  fd_ = -1;
+  if (::rename(temp_path_.c_str(), path_.c_str()) != 0) {
+    const int saved = errno;
+    ::unlink(temp_path_.c_str());
+    unregister_temp(temp_path_);
+    errno = saved;
+    throw_system_error("cannot rename " + temp_path_ + " to " + path_);
+  }
+  unregister_temp(temp_path_);
+}
+
+void write_file_atomically(const std::string& path, const void* data, std::size_t n) {
+  AtomicOutputFile file(path);
+  file.write(data, n);
+  file.commit();
+}
+
+}  // namespace qte

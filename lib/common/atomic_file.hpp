@@ -1,0 +1,38 @@
+// Output files appear whole or not at all: bytes go to "<path>.tmp.<pid>", which commit()
+// renames to <path>. A destructor without commit(), SIGINT, SIGTERM or SIGHUP removes the
+// temporary file, so a failed or interrupted tool never leaves a half file under the final name.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace qte {
+
+class AtomicOutputFile {
+ public:
+  explicit AtomicOutputFile(std::string path);
+  ~AtomicOutputFile();
+  AtomicOutputFile(const AtomicOutputFile&) = delete;
+  AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
+
+  void write(const void* data, std::size_t n);
+  // fsync, then rename over the final name. After this the file is complete on disk.
+  void commit();
+
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  std::string temp_path_;
+  int fd_ = -1;
+};
+
+// Writes all of `data` to `fd` (retrying on EINTR and short writes). Throws BrokenPipe on
+// EPIPE, Error otherwise; `what` names the destination in the message.
+void write_all(int fd, const void* data, std::size_t n, const std::string& what);
+
+// Convenience: the whole file at once, atomically.
+void write_file_atomically(const std::string& path, const void* data, std::size_t n);
+
+}  // namespace qte
