@@ -1,0 +1,71 @@
+# The two commands of the README, plus the targets they are made of.
+#   make demo    install what is missing, build, run the main job on the built-in tasks
+#   make check   install what is missing, build, run every test (ctest)
+# Other targets: deps, build, install, sanitize, fuzz, man, bench, clean.
+
+BUILD    ?= build
+JOBS     ?= $(shell nproc)
+CMAKE_FLAGS ?=
+PREFIX   ?= /usr/local
+FUZZ_SECONDS ?= 600
+APT_PACKAGES := $(shell sed -e 's/\#.*//' debian-packages.txt)
+TOOLS := $(basename $(notdir $(wildcard tools/*.cpp)))
+
+.PHONY: all deps build check check-slow demo install sanitize fuzz man bench clean
+
+all: build
+
+# Installs the Debian packages of debian-packages.txt that are not installed yet.
+deps:
+	@missing=$$(for p in $(APT_PACKAGES); do dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q '^install ok installed' || echo $$p; done); \
+	if [ -n "$$missing" ]; then \
+	  echo "installing Debian packages:" $$missing; \
+	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+	  $$SUDO apt-get update -q && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -q --no-install-recommends $$missing; \
+	fi
+
+$(BUILD)/CMakeCache.txt: | deps
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS)
+
+build: deps $(BUILD)/CMakeCache.txt
+	cmake --build $(BUILD) -j $(JOBS)
+
+# Every test except those labelled slow (see check-slow).
+check: build
+	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) -LE slow
+
+check-slow: build
+	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) -L slow
+
+demo: build
+	PATH="$(CURDIR)/$(BUILD)/tools:$$PATH" bash examples/demo.sh
+
+install: build
+	cmake --install $(BUILD) --prefix $(PREFIX)
+
+# AddressSanitizer + UndefinedBehaviorSanitizer build running the same tests.
+sanitize: deps
+	cmake -S . -B $(BUILD)-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DQTE_SANITIZE=ON $(CMAKE_FLAGS)
+	cmake --build $(BUILD)-asan -j $(JOBS)
+	ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+	  ctest --test-dir $(BUILD)-asan --output-on-failure -j $(JOBS) -LE slow
+
+# libFuzzer on the stream reader for FUZZ_SECONDS (clang from debian-packages.txt).
+fuzz: deps
+	cmake -S . -B $(BUILD)-fuzz -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
+	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DQTE_FUZZ=ON -DQTE_TESTS=ON $(CMAKE_FLAGS)
+	cmake --build $(BUILD)-fuzz -j $(JOBS) --target fuzz_stream_reader
+	mkdir -p tests/fuzz/findings $(BUILD)-fuzz/corpus
+	$(BUILD)-fuzz/tests/fuzz/fuzz_stream_reader -max_total_time=$(FUZZ_SECONDS) \
+	  -artifact_prefix=tests/fuzz/findings/ -print_final_stats=1 \
+	  $(BUILD)-fuzz/corpus tests/fuzz/corpus
+
+# Regenerates man/*.1 from the programs' own --help-man (a test checks they agree).
+man: build
+	for t in $(TOOLS); do $(BUILD)/tools/$$t --help-man > man/$$t.1; done
+
+bench: build
+	@echo "benchmarks arrive with the simulator and learner issues"
+
+clean:
+	rm -rf $(BUILD) $(BUILD)-asan $(BUILD)-fuzz

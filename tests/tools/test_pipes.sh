@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Streams through pipes: records pass unchanged, a reader that quits early stops the writer
+# quietly (no error message, no hang), binary output to a terminal is refused.
+set -uo pipefail
+tools=${QTE_TOOLS:?}
+export PATH="$tools:$PATH"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+
+for i in $(seq 1 50); do stream-pack obs "step:i32=$i" "x:f32[1000]=$(seq -s, 1 1000)"; done > "$tmp/many.rec"
+cmp "$tmp/many.rec" <(stream-cat < "$tmp/many.rec") || fail "stream-cat changed the bytes"
+[ "$(stream-dump --type obs --summary "$tmp/many.rec" | cut -f2)" = "50 records" ] || fail "summary"
+
+# Downstream exits after one line: upstream must end quietly and promptly.
+timeout 10 stream-cat "$tmp/many.rec" "$tmp/many.rec" "$tmp/many.rec" 2>"$tmp/err" | head -c 100 >/dev/null
+rc=${PIPESTATUS[0]}
+[ "$rc" = 141 ] || fail "stream-cat into a closed pipe: exit $rc, expected 141"
+[ ! -s "$tmp/err" ] || fail "stream-cat complained about a closed pipe: $(cat "$tmp/err")"
+err=$(timeout 10 stream-dump "$tmp/many.rec" 2>"$tmp/err" | head -n 1 >/dev/null; cat "$tmp/err")
+[ -z "$err" ] || fail "stream-dump complained about a closed pipe: $err"
+
+# Appending from several writers keeps every record whole.
+for w in 1 2 3 4; do stream-cat "$tmp/many.rec" --append --output "$tmp/replay.rec" & done; wait
+[ "$(stream-dump --summary "$tmp/replay.rec" | cut -f2)" = "200 records" ] || fail "concurrent append"
+
+# A terminal is refused (script gives us one when available).
+if command -v script >/dev/null; then
+  out=$(script -qec "$tools/stream-pack reset a=1" /dev/null)
+  grep -q "refusing to write a binary stream to a terminal" <<<"$out" \
+    || fail "binary output to a terminal was not refused: $out"
+fi
+echo "pipes ok"

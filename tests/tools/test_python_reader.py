@@ -1,0 +1,177 @@
+#!/usr/bin/env python3
+"""examples/read_stream.py, stream-dump --json and stream-dump --npy all give back, bit for bit,
+what stream-pack wrote: every dtype (extremes, NaN, infinities, -0), 0-d scalars, empty arrays,
+non-ASCII text and a zstd-compressed field. Damage makes the Python reader raise StreamError.
+Run with a python3 that has NumPy (ctest uses /usr/bin/python3)."""
+import importlib.util
+import io
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+TOOLS = os.environ.get("QTE_TOOLS") or "/work/main/build/tools"
+SOURCE = os.environ.get("QTE_SOURCE") or "/work/main"
+tmp = tempfile.mkdtemp(prefix="qte_pyreader_")
+failures = []
+
+spec = importlib.util.spec_from_file_location(
+    "read_stream", os.path.join(SOURCE, "examples", "read_stream.py"))
+read_stream = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(read_stream)
+
+
+def tool(name, *args, stdin=None):
+    r = subprocess.run([os.path.join(TOOLS, name), *args], input=stdin, capture_output=True)
+    if r.returncode != 0:
+        sys.exit(f"FAIL: {name} {' '.join(args)} exited {r.returncode}: {r.stderr.decode()}")
+    return r.stdout
+
+
+def text(values):  # how stream-pack takes values: repr() round-trips float64 exactly
+    return ",".join("nan" if v != v else repr(float(v)) if isinstance(v, np.floating)
+                    else str(int(v)) for v in values.reshape(-1))
+
+
+# --- what we write: (record type, {field name: expected value}) -------------------------------
+records, specs = [], []
+for name in "uint8 int8 uint16 int16 uint32 int32 uint64 int64 float32 float64".split():
+    dt = np.dtype(name)
+    if dt.kind == "f":
+        fi = np.finfo(dt)
+        special = [fi.max, -fi.max, fi.tiny, fi.eps, -0.0, np.nan, np.inf, -np.inf, 1 / 3]
+        if dt == np.float32:
+            special.append(fi.smallest_subnormal)  # float64 subnormals: see the .npy field
+        matrix = np.array(special + [np.pi] * (12 - len(special)), dt).reshape(3, 4)
+        scalar = dt.type(-2.5)
+    else:
+        ii = np.iinfo(dt)
+        matrix = np.array([ii.min, ii.max, 0, 1, ii.max - 1, ii.min + 1], dt).reshape(2, 1, 3)
+        scalar = dt.type(ii.max)
+    fields = {"matrix": matrix, "scalar": np.array(scalar, dt), "empty": np.zeros(0, dt),
+              "deep": np.arange(4).astype(dt).reshape(1, 1, 1, 2, 1, 1, 2, 1)}
+    args = [f"{k}:{name}[{','.join(map(str, v.shape))}]={text(v)}" for k, v in fields.items()
+            if k != "scalar"] + [f"scalar:{name}={text(fields['scalar'])}"]
+    records.append((f"dt_{name}", fields))
+    specs.append(([f"dt_{name}"] + args, None))
+
+subnormals = np.array([5e-324, -5e-324, 2.2250738585072009e-308], np.float64)
+np.save(os.path.join(tmp, "sub.npy"), subnormals)
+words = "héllo wörld, ∂x/∂t → 日本語 ✓"
+records.append(("text", {"word": words, "empty": "", "f64sub": subnormals}))
+specs.append((["text", f"word={words}", "empty=", "f64sub=@" + os.path.join(tmp, "sub.npy")], None))
+
+depth = (np.arange(256 * 256, dtype=np.uint16) // 7 % 1000).reshape(256, 256)
+np.save(os.path.join(tmp, "depth.npy"), depth)
+compressed = ("obs", {"front.depth": depth, "step": np.array(3, np.int32)})
+records.append(compressed)
+specs.append((["obs", "front.depth=@" + os.path.join(tmp, "depth.npy"), "step:i32=3",
+               "--compress"], None))
+
+stream = b"".join(tool("stream-pack", *args) for args, _ in specs)
+path = os.path.join(tmp, "all.rec")
+with open(path, "wb") as f:
+    f.write(stream)
+if len(stream) >= depth.nbytes:
+    failures.append(f"--compress did not compress: stream is {len(stream)} bytes")
+
+
+def same(where, got, want):
+    if isinstance(want, str):
+        ok = got == want
+    else:
+        ok = (isinstance(got, np.ndarray) and got.dtype.str == want.dtype.str
+              and got.shape == want.shape and got.tobytes() == want.tobytes())
+    if not ok:
+        failures.append(f"{where}: got {got!r}, expected {want!r}")
+
+
+# --- 1. the Python reader ---------------------------------------------------------------------
+try:
+    import zstandard  # noqa: F401
+    have_zstd = True
+except ImportError:
+    have_zstd = False
+    print("note: Python module zstandard missing, so the compressed record is not read with "
+          "read_stream.py (install python3-zstandard)")
+for source in (path, io.BytesIO(stream)):
+    got = []
+    try:
+        for record in read_stream.read_records(source):
+            got.append(record)
+    except read_stream.StreamError as e:
+        if have_zstd or len(got) != len(records) - 1 or "zstandard" not in str(e):
+            failures.append(f"read_stream.py: {e}")
+    offset = 0
+    for i, (record, (rtype, fields)) in enumerate(zip(got, records)):
+        if (record.type, record.index, record.offset) != (rtype, i, offset):
+            failures.append(f"record {i}: {record.type} #{record.index} @{record.offset}")
+        offset += len(tool("stream-pack", *specs[i][0]))
+        if list(record.fields) != list(fields):
+            failures.append(f"record {i}: fields {list(record.fields)}, expected {list(fields)}")
+        for name, want in fields.items():
+            same(f"read_stream.py record {i} field {name}", record.fields.get(name), want)
+
+# --- 2. stream-dump --json --all-values -------------------------------------------------------
+SPECIAL = {"nan": np.nan, "inf": np.inf, "-inf": -np.inf}
+lines = tool("stream-dump", "--json", "--all-values", path).decode("utf-8").splitlines()
+if len(lines) != len(records):
+    failures.append(f"stream-dump --json printed {len(lines)} lines for {len(records)} records")
+for i, (line, (rtype, fields)) in enumerate(zip(lines, records)):
+    obj = json.loads(line, parse_int=lambda s: -0.0 if s == "-0" else int(s))  # keep -0's sign
+    if obj["type"] != rtype or obj["index"] != i:
+        failures.append(f"json record {i}: {line[:80]}")
+    if [f["name"] for f in obj["fields"]] != list(fields):
+        failures.append(f"json record {i}: field names {[f['name'] for f in obj['fields']]}")
+    for f in obj["fields"]:
+        want = fields.get(f["name"])
+        if f["dtype"] == "str":
+            same(f"json record {i} field {f['name']}", f["value"], want)
+            continue
+        if not f["complete"]:
+            failures.append(f"json record {i} field {f['name']}: values not complete")
+        values = [SPECIAL[v] if isinstance(v, str) else v for v in f["values"]]
+        dt = np.dtype(f["dtype"])
+        got = np.array(values, dtype=object if dt.kind in "iu" else dt)
+        got = got.astype(dt).reshape(f["shape"]) if dt.kind in "iu" else got.reshape(f["shape"])
+        if dt.kind in "iu" and [int(v) for v in got.reshape(-1)] != values:
+            failures.append(f"json record {i} field {f['name']}: integers out of range")
+        same(f"json record {i} field {f['name']}", got, want)
+
+# --- 3. stream-dump --npy ---------------------------------------------------------------------
+npy_dir = os.path.join(tmp, "npy")
+tool("stream-dump", "--npy", npy_dir, path)
+expected = {f"{i:06d}.{rtype}.{name}.npy": want
+            for i, (rtype, fields) in enumerate(records) for name, want in fields.items()}
+if sorted(os.listdir(npy_dir)) != sorted(expected):
+    failures.append(f"--npy wrote {sorted(os.listdir(npy_dir))}, expected {sorted(expected)}")
+for file, want in expected.items():
+    if os.path.exists(os.path.join(npy_dir, file)):
+        got = np.load(os.path.join(npy_dir, file))
+        if isinstance(want, str):  # text is exported as one bytes string (|S<n>)
+            got = got.item().decode("utf-8") if got.dtype.kind == "S" and got.ndim == 0 else got
+        same(f"--npy {file}", got, want)
+
+# --- 4. damage: StreamError, nothing else -----------------------------------------------------
+plain = stream[:-len(tool("stream-pack", *specs[-1][0]))]  # all but the compressed record
+second = len(tool("stream-pack", *specs[0][0]))
+flipped = bytearray(plain)
+flipped[second + 64 + 100] ^= 0x01
+for what, data, where in [("truncated payload", plain[:-5], f"record {len(records) - 2} at"),
+                          ("truncated header", plain[:second + 30], f"record 1 at byte {second}"),
+                          ("flipped payload byte", bytes(flipped), f"record 1 at byte {second}")]:
+    try:
+        list(read_stream.read_records(io.BytesIO(data)))
+        failures.append(f"{what}: no error")
+    except read_stream.StreamError as e:
+        if where not in str(e):
+            failures.append(f"{what}: message {e} does not name '{where}'")
+    except Exception as e:  # noqa: BLE001 - any other exception is the failure tested for
+        failures.append(f"{what}: {type(e).__name__} instead of StreamError: {e}")
+
+print("\n".join(failures) or f"{len(records)} records read back bit for bit by read_stream.py, "
+      "stream-dump --json and stream-dump --npy; damage raises StreamError")
+sys.exit(1 if failures else 0)
