@@ -110,7 +110,8 @@ bool Arguments::flag(const std::string& name) const { return has(name); }
 std::string Arguments::text(const std::string& name) const {
   auto it = given_.find(name);
   if (it != given_.end()) return it->second.back();
-  const OptionSpec* o = find_option(all_options(*usage_), name);
+  const auto options = all_options(*usage_);
+  const OptionSpec* o = find_option(options, name);
   if (!o) throw Error("internal: option --" + name + " is not declared");
   return o->default_value;
 }
