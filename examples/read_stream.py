@@ -10,6 +10,7 @@ str fields are Python strings. zstd-compressed fields need the `zstandard` modul
 Run as a script to list the records of streams (like stream-dump).
 """
 import collections
+import os
 import re
 import struct
 import sys
@@ -151,11 +152,8 @@ def _fields(payload, count, max_field_bytes, error):
         else:
             data, start = _unzstd(payload[at:at + stored], raw_bytes, max_field_bytes,
                                   lambda what: bad(f"'{name}': {what}")), 0
-        if code == STR:
-            try:
-                fields[name] = data[start:start + raw_bytes].decode("utf-8")
-            except UnicodeDecodeError as e:
-                raise bad(f"'{name}': str field is not UTF-8 ({e.reason})") from None
+        if code == STR:  # like the C++ reader, accept bad UTF-8 (and keep its bytes)
+            fields[name] = data[start:start + raw_bytes].decode("utf-8", "surrogateescape")
         else:
             fields[name] = np.frombuffer(data, dtype, elements, start).reshape(shape)
         at += pad64(stored)
@@ -192,7 +190,8 @@ def main(paths):
             print(f"#{record.index} @{record.offset} {record.type} ({len(record.fields)} fields)")
             for name, value in record.fields.items():
                 if isinstance(value, str):
-                    print(f"  {name}  str [{len(value.encode())}]  {value!r}")
+                    size = len(value.encode("utf-8", "surrogateescape"))
+                    print(f"  {name}  str [{size}]  {value!r}")
                     continue
                 flat = value.reshape(-1)
                 shown = " ".join(str(v) for v in flat[:6]) + (" ..." if flat.size > 6 else "")
@@ -203,7 +202,8 @@ def main(paths):
 if __name__ == "__main__":
     try:
         main(sys.argv[1:])
-    except StreamError as e:
-        sys.exit(f"read_stream.py: {e}")
-    except BrokenPipeError:
+    except BrokenPipeError:  # e.g. `read_stream.py demos.rec | head`: stop quietly
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         sys.exit(141)
+    except (StreamError, OSError) as e:
+        sys.exit(f"read_stream.py: {e}")

@@ -25,7 +25,7 @@ static cli::Usage usage() {
       {"type", "T", "keep only records of type T", "", true},
       {"exclude", "T", "drop records of type T", "", true},
       {"head", "N", "stop after N records have been written; -1 for no limit", "-1"},
-      {"max-record-bytes", "N", "treat records larger than N bytes as damage",
+      {"max-record-bytes", "N", "treat a record payload or decompressed field larger than N bytes as damage",
        std::to_string(uint64_t(4) << 30)},
   };
   u.examples = {
@@ -46,6 +46,7 @@ static void run(const cli::Arguments& args) {
       drop_types(drop.begin(), drop.end());
   const int64_t head = args.integer("head");
   stream::ReadOptions read_options;
+  if (args.integer("max-record-bytes") <= 0) throw UsageError("--max-record-bytes must be positive");
   read_options.max_record_bytes = static_cast<uint64_t>(args.integer("max-record-bytes"));
   stream::WriteOptions write_options;
   if (args.flag("append")) {

@@ -34,7 +34,7 @@ static cli::Usage usage() {
       {"all-values", "", "show every value (same as --values -1)", ""},
       {"npy", "DIR", "also export every field of the shown records as .npy files into DIR", ""},
       {"summary", "", "print only a count of records and bytes per type at the end", ""},
-      {"max-record-bytes", "N", "treat records larger than N bytes as damage",
+      {"max-record-bytes", "N", "treat a record payload or decompressed field larger than N bytes as damage",
        std::to_string(uint64_t(4) << 30)},
   };
   u.examples = {
@@ -65,6 +65,7 @@ static void run(const cli::Arguments& args) {
   if (!npy_dir.empty() && ::mkdir(npy_dir.c_str(), 0755) != 0 && errno != EEXIST)
     throw_system_error("cannot create directory " + npy_dir);
   stream::ReadOptions read_options;
+  if (args.integer("max-record-bytes") <= 0) throw UsageError("--max-record-bytes must be positive");
   read_options.max_record_bytes = static_cast<uint64_t>(args.integer("max-record-bytes"));
 
   std::map<std::string, std::pair<uint64_t, uint64_t>> totals;  // type -> (records, bytes)

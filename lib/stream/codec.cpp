@@ -147,8 +147,8 @@ Record decode_payload(const RecordHeader& header, std::shared_ptr<const uint8_t>
       shape[k] = load<int64_t>(d + kDescriptorFixedBytes + 8 * k);
       if (shape[k] < 0 || shape[k] > kMaxExtent)
         throw bad("extent " + std::to_string(shape[k]) + " in dimension " + std::to_string(k));
+      if (shape[k] != 0 && count > kMaxExtent / shape[k]) throw bad("more than 2^40 elements");
       count *= shape[k];
-      if (count > kMaxExtent) throw bad("more than 2^40 elements");
     }
     std::string name(reinterpret_cast<const char*>(d + kDescriptorFixedBytes + 8 * ndim),
                      name_len);
@@ -173,11 +173,15 @@ Record decode_payload(const RecordHeader& header, std::shared_ptr<const uint8_t>
         throw bad("'" + name + "': decompressed size " + std::to_string(raw_bytes) +
                   " exceeds the limit of " + std::to_string(max_field_bytes));
       const unsigned long long content = ZSTD_getFrameContentSize(data, stored);
+      if (content >= ZSTD_CONTENTSIZE_ERROR)
+        throw bad("'" + name + "': zstd frame without a content size (expected " +
+                  std::to_string(raw_bytes) + " bytes)");
       if (content != raw_bytes)
-        throw bad("'" + name + "': zstd frame declares " +
-                  (content >= ZSTD_CONTENTSIZE_ERROR ? std::string("no valid size")
-                                                     : std::to_string(content)) +
+        throw bad("'" + name + "': zstd frame declares " + std::to_string(content) +
                   " bytes, shape needs " + std::to_string(raw_bytes));
+      if (ZSTD_findFrameCompressedSize(data, stored) != stored)
+        throw bad("'" + name + "': expected exactly one zstd frame in " + std::to_string(stored) +
+                  " bytes");
       const std::size_t padded = pad64(raw_bytes ? raw_bytes : 1);
       auto* out = static_cast<uint8_t*>(std::aligned_alloc(kAlignment, padded));
       if (!out) throw std::bad_alloc();
@@ -191,8 +195,7 @@ Record decode_payload(const RecordHeader& header, std::shared_ptr<const uint8_t>
       field.compress = true;  // written again compressed when passed through
       record.add(std::move(field));
     }
-    at += pad64(stored);
-    if (at > size) throw bad("data padding runs past the payload end");
+    at += pad64(stored);  // within the payload: stored <= size - at and sizes are 64-multiples
   }
   if (at != size)
     throw StreamError(where, std::to_string(size - at) +

@@ -1,6 +1,8 @@
 #include "stream/field_spec.hpp"
 
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <sstream>
 #include <vector>
@@ -18,16 +20,22 @@ void add_numbers(Record& record, const std::string& name, const Shape& shape,
     try {
       std::size_t used = 0;
       if constexpr (std::is_floating_point_v<T>) {
-        const double v = std::stod(item, &used);
-        values.push_back(static_cast<T>(v));
+        // strtof/strtod round correctly for the target type and keep subnormals.
+        errno = 0;
+        char* end = nullptr;
+        const T v = std::is_same_v<T, float> ? static_cast<T>(std::strtof(item.c_str(), &end))
+                                             : static_cast<T>(std::strtod(item.c_str(), &end));
+        used = static_cast<std::size_t>(end - item.c_str());
+        if (item.empty() || (errno == ERANGE && std::isinf(v))) throw std::out_of_range(item);
+        values.push_back(v);
       } else if constexpr (std::is_signed_v<T>) {
-        const long long v = std::stoll(item, &used, 0);
+        const long long v = std::stoll(item, &used, 10);
         if (v < std::numeric_limits<T>::min() || v > std::numeric_limits<T>::max())
           throw std::out_of_range(item);
         values.push_back(static_cast<T>(v));
       } else {
-        if (!item.empty() && item[0] == '-') throw std::out_of_range(item);
-        const unsigned long long v = std::stoull(item, &used, 0);
+        if (item.find('-') != std::string::npos) throw std::out_of_range(item);
+        const unsigned long long v = std::stoull(item, &used, 10);
         if (v > std::numeric_limits<T>::max()) throw std::out_of_range(item);
         values.push_back(static_cast<T>(v));
       }

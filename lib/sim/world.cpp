@@ -1,0 +1,353 @@
+#include "sim/world.hpp"
+
+#include <btBulletDynamicsCommon.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/error.hpp"
+
+namespace qte::sim {
+namespace {
+
+btTransform to_bullet(const Eigen::Isometry3d& pose) {
+  const Eigen::Quaterniond q(pose.linear());
+  return btTransform(btQuaternion(q.x(), q.y(), q.z(), q.w()),
+                     btVector3(pose.translation().x(), pose.translation().y(), pose.translation().z()));
+}
+
+Eigen::Isometry3d from_bullet(const btTransform& t) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  const btQuaternion q = t.getRotation();
+  pose.linear() = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()).toRotationMatrix();
+  pose.translation() << t.getOrigin().x(), t.getOrigin().y(), t.getOrigin().z();
+  return pose;
+}
+
+std::unique_ptr<btCollisionShape> make_shape(const ObjectSpec& spec) {
+  const Eigen::Vector3d& s = spec.size;
+  switch (spec.shape) {
+    case ObjectSpec::Shape::box:
+      return std::make_unique<btBoxShape>(btVector3(s.x() / 2, s.y() / 2, s.z() / 2));
+    case ObjectSpec::Shape::cylinder:
+      return std::make_unique<btCylinderShapeZ>(btVector3(s.x(), s.x(), s.y() / 2));
+    case ObjectSpec::Shape::sphere:
+      return std::make_unique<btSphereShape>(s.x());
+    case ObjectSpec::Shape::convex_hull: {
+      auto hull = std::make_unique<btConvexHullShape>();
+      for (const auto& p : spec.hull_points) hull->addPoint(btVector3(p.x(), p.y(), p.z()), false);
+      hull->recalcLocalAabb();
+      hull->setMargin(0.001);
+      return hull;
+    }
+  }
+  throw Error("unknown object shape");
+}
+
+// Counts contacts deeper than a tolerance between two objects.
+struct PenetrationCallback : btCollisionWorld::ContactResultCallback {
+  double tolerance_m;
+  bool touching = false;
+  explicit PenetrationCallback(double tolerance) : tolerance_m(tolerance) {}
+  btScalar addSingleResult(btManifoldPoint& point, const btCollisionObjectWrapper*, int, int,
+                           const btCollisionObjectWrapper*, int, int) override {
+    if (point.getDistance() < -tolerance_m) touching = true;
+    return 0;
+  }
+};
+
+}  // namespace
+
+struct World::Impl {
+  btDefaultCollisionConfiguration configuration;
+  btCollisionDispatcher dispatcher{&configuration};
+  btDbvtBroadphase broadphase;
+  btSequentialImpulseConstraintSolver solver;
+  btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &configuration};
+
+  struct Body {
+    std::unique_ptr<btCollisionShape> shape;
+    std::vector<std::unique_ptr<btCollisionShape>> children;
+    std::unique_ptr<btDefaultMotionState> motion;
+    std::unique_ptr<btRigidBody> body;
+    std::unique_ptr<render::Appearance> appearance;
+  };
+  Body table, floor;
+  std::vector<Body> links;    // one per robot link (null body for links without shapes)
+  std::vector<Body> objects;  // task objects, by id
+  std::vector<ObjectSpec> specs;
+  std::vector<std::pair<int, int>> checked_link_pairs;  // for self-collision
+
+  ~Impl() {
+    for (auto* list : {&objects, &links})
+      for (auto& b : *list)
+        if (b.body) world.removeRigidBody(b.body.get());
+    for (auto* b : {&table, &floor})
+      if (b->body) world.removeRigidBody(b->body.get());
+  }
+
+  Body make_body(std::unique_ptr<btCollisionShape> shape, double mass, const btTransform& pose,
+                 const render::Appearance& appearance) {
+    Body b;
+    b.shape = std::move(shape);
+    b.motion = std::make_unique<btDefaultMotionState>(pose);
+    btVector3 inertia(0, 0, 0);
+    if (mass > 0) b.shape->calculateLocalInertia(mass, inertia);
+    btRigidBody::btRigidBodyConstructionInfo info(mass, b.motion.get(), b.shape.get(), inertia);
+    info.m_friction = 0.8;
+    info.m_rollingFriction = 0.001;
+    info.m_spinningFriction = 0.001;
+    b.body = std::make_unique<btRigidBody>(info);
+    b.appearance = std::make_unique<render::Appearance>(appearance);
+    b.body->setUserPointer(b.appearance.get());
+    return b;
+  }
+};
+
+World::World(const robot::RobotModel& robot, const SceneLayout& layout)
+    : impl_(std::make_unique<Impl>()), robot_(robot), layout_(layout) {
+  auto& w = impl_->world;
+  w.setGravity(btVector3(0, 0, -9.81));
+
+  render::Appearance wood, ground;
+  wood.colour << 0.72f, 0.56f, 0.40f;
+  ground.colour << 0.35f, 0.35f, 0.38f;
+  const double thickness = 0.05;
+  btTransform table_pose(btQuaternion::getIdentity(),
+                         btVector3(layout.table_centre.x(), layout.table_centre.y(),
+                                   layout.table_height_m - thickness / 2));
+  impl_->table = impl_->make_body(
+      std::make_unique<btBoxShape>(btVector3(layout.table_extent_m.x() / 2,
+                                             layout.table_extent_m.y() / 2, thickness / 2)),
+      0, table_pose, wood);
+  impl_->floor = impl_->make_body(std::make_unique<btBoxShape>(btVector3(5, 5, 0.05)), 0,
+                                  btTransform(btQuaternion::getIdentity(), btVector3(0, 0, -0.05)),
+                                  ground);
+  w.addRigidBody(impl_->table.body.get());
+  w.addRigidBody(impl_->floor.body.get());
+
+  // Robot links: kinematic bodies made of their primitive shapes.
+  for (const auto& link : robot.links()) {
+    Impl::Body body;
+    if (!link.shapes.empty()) {
+      auto compound = std::make_unique<btCompoundShape>();
+      std::vector<std::unique_ptr<btCollisionShape>> children;
+      for (const auto& s : link.shapes) {
+        std::unique_ptr<btCollisionShape> child;
+        if (s.kind == robot::Shape::Kind::box)
+          child = std::make_unique<btBoxShape>(btVector3(s.size.x() / 2, s.size.y() / 2, s.size.z() / 2));
+        else if (s.kind == robot::Shape::Kind::cylinder)
+          child = std::make_unique<btCylinderShapeZ>(btVector3(s.size.x(), s.size.x(), s.size.y() / 2));
+        else
+          child = std::make_unique<btSphereShape>(s.size.x());
+        compound->addChildShape(to_bullet(s.link_from_shape), child.get());
+        children.push_back(std::move(child));
+      }
+      render::Appearance look;
+      look.colour = link.colour;
+      body = impl_->make_body(std::move(compound), 0, btTransform::getIdentity(), look);
+      body.children = std::move(children);
+      body.body->setCollisionFlags(body.body->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
+      body.body->setActivationState(DISABLE_DEACTIVATION);
+      w.addRigidBody(body.body.get());
+    }
+    impl_->links.push_back(std::move(body));
+  }
+  // Self-collision is checked between links more than two joints apart (neighbours overlap
+  // by construction at the joints); fingers and gripper form one rigid group.
+  const auto& joints = robot.joints();
+  auto depth_of = [&](int link) {
+    int d = 0;
+    for (int j = robot.links()[link].parent_joint; j >= 0; j = robot.links()[joints[j].parent_link].parent_joint)
+      if (joints[j].type != robot::Joint::Type::fixed && !joints[j].finger) ++d;
+    return d;
+  };
+  for (std::size_t a = 0; a < robot.links().size(); ++a)
+    for (std::size_t b = a + 1; b < robot.links().size(); ++b)
+      if (impl_->links[a].body && impl_->links[b].body &&
+          std::abs(depth_of(static_cast<int>(a)) - depth_of(static_cast<int>(b))) > 2)
+        impl_->checked_link_pairs.emplace_back(static_cast<int>(a), static_cast<int>(b));
+
+  // Ready pose: the gripper above the table, pointing down, open.
+  robot::JointVector ready;
+  ready << 0, -0.35, 0, 0.75, 0, 1.1, 0;
+  set_robot_state(ready, robot.max_finger_opening_m());
+}
+
+World::~World() = default;
+
+Eigen::Isometry3d World::robot_base_pose() const {
+  Eigen::Isometry3d base = Eigen::Isometry3d::Identity();
+  base.translation() = layout_.robot_base;
+  return base;
+}
+
+int World::add_object(const ObjectSpec& spec) {
+  if (spec.name.empty()) throw Error("an object needs a name");
+  for (const auto& s : impl_->specs)
+    if (s.name == spec.name) throw Error("two objects named '" + spec.name + "'");
+  Impl::Body body = impl_->make_body(make_shape(spec), spec.mass_kg, to_bullet(spec.pose), spec.appearance);
+  if (!spec.collides)
+    body.body->setCollisionFlags(body.body->getCollisionFlags() | btCollisionObject::CF_NO_CONTACT_RESPONSE);
+  impl_->world.addRigidBody(body.body.get());
+  impl_->objects.push_back(std::move(body));
+  impl_->specs.push_back(spec);
+  return static_cast<int>(impl_->objects.size()) - 1;
+}
+
+int World::object_count() const { return static_cast<int>(impl_->objects.size()); }
+const ObjectSpec& World::object_spec(int id) const { return impl_->specs.at(id); }
+
+int World::object_id(const std::string& name) const {
+  for (std::size_t i = 0; i < impl_->specs.size(); ++i)
+    if (impl_->specs[i].name == name) return static_cast<int>(i);
+  throw Error("the scene has no object '" + name + "'");
+}
+
+Eigen::Isometry3d World::object_pose(int id) const {
+  return from_bullet(impl_->objects.at(id).body->getWorldTransform());
+}
+
+Eigen::Isometry3d World::link_pose(int link) const {
+  return robot_base_pose() * robot_.link_poses(q_, opening_m_)[link];
+}
+
+Eigen::Isometry3d World::tcp_pose() const { return link_pose(robot_.tcp_link()); }
+
+void World::place_robot_links() {
+  const auto poses = robot_.link_poses(q_, opening_m_);
+  const Eigen::Isometry3d base = robot_base_pose();
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    auto& body = impl_->links[i].body;
+    if (!body) continue;
+    const btTransform t = to_bullet(base * poses[i]);
+    body->getMotionState()->setWorldTransform(t);
+    body->setWorldTransform(t);
+  }
+  if (held_ >= 0) {
+    auto& body = impl_->objects[held_].body;
+    const btTransform t = to_bullet(base * poses[robot_.tcp_link()] * held_from_tcp_);
+    body->getMotionState()->setWorldTransform(t);
+    body->setWorldTransform(t);
+  }
+}
+
+void World::set_robot_state(const robot::JointVector& q, double finger_opening_m) {
+  q_ = q;
+  opening_m_ = std::clamp(finger_opening_m, 0.0, robot_.max_finger_opening_m());
+  place_robot_links();
+  // Kinematic bodies must not carry the teleport as a velocity into the next step.
+  for (auto& link : impl_->links)
+    if (link.body) link.body->saveKinematicState(kPhysicsStep);
+  impl_->world.updateAabbs();
+}
+
+void World::physics_substep() { impl_->world.stepSimulation(kPhysicsStep, 1, kPhysicsStep); }
+
+void World::step_towards(const robot::JointVector& q, double finger_opening_m, double dt_s) {
+  const int steps = std::max(1, static_cast<int>(std::lround(dt_s / kPhysicsStep)));
+  const robot::JointVector q0 = q_;
+  const double opening0 = opening_m_;
+  for (int i = 1; i <= steps; ++i) {
+    const double t = static_cast<double>(i) / steps;
+    q_ = q0 + t * (q - q0);
+    opening_m_ = opening0 + t * (finger_opening_m - opening0);
+    place_robot_links();
+    physics_substep();
+  }
+}
+
+void World::settle(double seconds) {
+  const int steps = std::max(1, static_cast<int>(std::lround(seconds / kPhysicsStep)));
+  for (int i = 0; i < steps; ++i) {
+    place_robot_links();
+    physics_substep();
+  }
+}
+
+int World::close_gripper() {
+  gripper_open_ = false;
+  if (held_ >= 0) return held_;
+  // Look for a graspable object whose centre lies between the fingers and that fits.
+  const Eigen::Isometry3d tcp = tcp_pose();
+  const double finger_length = 0.055, finger_width = 0.02;
+  int best = -1;
+  double best_distance = 1e9, best_width = 0;
+  for (int id = 0; id < object_count(); ++id) {
+    const ObjectSpec& spec = impl_->specs[id];
+    if (!spec.graspable || spec.mass_kg <= 0) continue;
+    const Eigen::Isometry3d in_tcp = tcp.inverse() * object_pose(id);
+    // Half extent of the object along the closing axis (tcp y), from its bounding box.
+    btVector3 lo, hi;
+    impl_->objects[id].shape->getAabb(btTransform::getIdentity(), lo, hi);
+    const Eigen::Vector3d half((hi - lo).x() / 2, (hi - lo).y() / 2, (hi - lo).z() / 2);
+    const double half_y = (in_tcp.linear().row(1).cwiseAbs()) * half;
+    const double half_x = (in_tcp.linear().row(0).cwiseAbs()) * half;
+    const Eigen::Vector3d c = in_tcp.translation();
+    const bool between = std::abs(c.y()) + half_y <= opening_m_ / 2 + 0.002 &&
+                         std::abs(c.x()) <= finger_width / 2 + half_x &&
+                         c.z() >= -finger_length - 0.01 && c.z() <= 0.01 + half_y;
+    if (between && c.norm() < best_distance) {
+      best = id;
+      best_distance = c.norm();
+      best_width = 2 * half_y;
+    }
+  }
+  const double closed = best >= 0 ? best_width : 0.0;
+  // Close over a quarter second so the motion is visible in recorded demonstrations.
+  step_towards(q_, std::max(closed, 0.0), 0.25);
+  if (best >= 0) {
+    held_ = best;
+    auto& body = *impl_->objects[best].body;
+    impl_->world.removeRigidBody(&body);
+    body.setMassProps(0, btVector3(0, 0, 0));
+    body.setCollisionFlags(body.getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
+    body.setActivationState(DISABLE_DEACTIVATION);
+    body.setLinearVelocity(btVector3(0, 0, 0));
+    body.setAngularVelocity(btVector3(0, 0, 0));
+    impl_->world.addRigidBody(&body);
+    held_from_tcp_ = tcp_pose().inverse() * object_pose(best);
+  }
+  return held_;
+}
+
+void World::open_gripper() {
+  gripper_open_ = true;
+  if (held_ >= 0) {
+    auto& body = *impl_->objects[held_].body;
+    const double mass = impl_->specs[held_].mass_kg;
+    impl_->world.removeRigidBody(&body);
+    btVector3 inertia(0, 0, 0);
+    body.getCollisionShape()->calculateLocalInertia(mass, inertia);
+    body.setCollisionFlags(body.getCollisionFlags() & ~btCollisionObject::CF_KINEMATIC_OBJECT);
+    body.setMassProps(mass, inertia);
+    body.updateInertiaTensor();
+    body.setLinearVelocity(btVector3(0, 0, 0));
+    body.setAngularVelocity(btVector3(0, 0, 0));
+    body.forceActivationState(ACTIVE_TAG);
+    impl_->world.addRigidBody(&body);
+    held_ = -1;
+  }
+  step_towards(q_, robot_.max_finger_opening_m(), 0.25);
+}
+
+std::string World::robot_collision() const {
+  auto& w = const_cast<btDiscreteDynamicsWorld&>(impl_->world);  // contactPairTest is not const
+  const auto& links = robot_.links();
+  for (std::size_t i = 0; i < impl_->links.size(); ++i) {
+    if (!impl_->links[i].body) continue;
+    PenetrationCallback table(0.002);
+    w.contactPairTest(impl_->links[i].body.get(), impl_->table.body.get(), table);
+    if (table.touching) return "collision:" + links[i].name + "-table";
+  }
+  for (const auto& [a, b] : impl_->checked_link_pairs) {
+    PenetrationCallback self(0.002);
+    w.contactPairTest(impl_->links[a].body.get(), impl_->links[b].body.get(), self);
+    if (self.touching) return "collision:" + links[a].name + "-" + links[b].name;
+  }
+  return "";
+}
+
+const btCollisionWorld& World::collision_world() const { return impl_->world; }
+
+}  // namespace qte::sim

@@ -1,0 +1,102 @@
+// The simulated scene: a Bullet dynamics world with a table, the robot driven kinematically
+// along joint trajectories, and rigid objects that react physically when pushed. Grasping
+// attaches the object between the fingers to the gripper on close, as RLBench does.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "render/camera.hpp"
+#include "robot/robot_model.hpp"
+
+class btCollisionWorld;
+
+namespace qte::sim {
+
+struct ObjectSpec {
+  enum class Shape { box, cylinder, sphere, convex_hull };
+  std::string name;
+  Shape shape = Shape::box;
+  Eigen::Vector3d size = Eigen::Vector3d::Constant(0.05);  // box: extents; cylinder: (radius,
+                                                           // height, -); sphere: (radius, -, -)
+  std::vector<Eigen::Vector3d> hull_points;  // convex_hull: vertices in the object frame
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  double mass_kg = 0.1;     // 0: static (never moves)
+  bool collides = true;     // false: seen by cameras only (e.g. a success zone)
+  bool graspable = true;
+  render::Appearance appearance;
+};
+
+// What the table and the robot base look like; tasks share one layout (DESIGN §4-§5).
+struct SceneLayout {
+  double table_height_m = 0.752;
+  Eigen::Vector3d table_centre{0.2, 0.0, 0.752};  // top surface centre
+  Eigen::Vector2d table_extent_m{1.2, 1.4};
+  Eigen::Vector3d robot_base{-0.3, 0.0, 0.752};
+};
+
+class World {
+ public:
+  World(const robot::RobotModel& robot, const SceneLayout& layout = {});
+  ~World();
+  World(const World&) = delete;
+  World& operator=(const World&) = delete;
+
+  const robot::RobotModel& robot() const { return robot_; }
+  const SceneLayout& layout() const { return layout_; }
+  Eigen::Isometry3d robot_base_pose() const;
+
+  // --- objects --------------------------------------------------------------------------
+  int add_object(const ObjectSpec& spec);  // returns the object's id
+  int object_count() const;
+  const ObjectSpec& object_spec(int id) const;
+  int object_id(const std::string& name) const;  // throws Error when absent
+  Eigen::Isometry3d object_pose(int id) const;
+
+  // --- the robot ------------------------------------------------------------------------
+  // Places the arm and fingers at once (no physics in between): resets and teleports.
+  void set_robot_state(const robot::JointVector& q, double finger_opening_m);
+  const robot::JointVector& joint_positions() const { return q_; }
+  double finger_opening_m() const { return opening_m_; }
+  Eigen::Isometry3d tcp_pose() const;  // world frame
+  Eigen::Isometry3d link_pose(int link) const;  // world frame
+
+  // Moves the robot kinematically to (q, opening) over dt_s seconds of physics, so objects
+  // in the way are pushed. A held object moves with the gripper.
+  void step_towards(const robot::JointVector& q, double finger_opening_m, double dt_s);
+  // Physics only (objects settle), the robot standing still.
+  void settle(double seconds);
+
+  // Closes the gripper: the graspable object between the fingers (if any) is held and the
+  // fingers stop on its faces. Returns its id or -1.
+  int close_gripper();
+  void open_gripper();
+  int held_object() const { return held_; }
+  bool gripper_open() const { return gripper_open_; }  // the last gripper command
+
+  // Robot contacts that make an action fail: a link touching the table or another link
+  // (not its neighbours). Empty when none; otherwise a reason such as "collision:link3-table".
+  std::string robot_collision() const;
+
+  const btCollisionWorld& collision_world() const;
+  static constexpr double kPhysicsStep = 1.0 / 240.0;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  const robot::RobotModel& robot_;
+  SceneLayout layout_;
+  robot::JointVector q_ = robot::JointVector::Zero();
+  double opening_m_ = 0;
+  int held_ = -1;
+  bool gripper_open_ = true;
+  Eigen::Isometry3d held_from_tcp_ = Eigen::Isometry3d::Identity();
+
+  void place_robot_links();
+  void physics_substep();
+};
+
+}  // namespace qte::sim

@@ -1,0 +1,228 @@
+#include "simulator/simulator.hpp"
+
+#include <cmath>
+
+#include "common/error.hpp"
+#include "common/random.hpp"
+
+namespace qte::simulator {
+namespace {
+
+constexpr double kStartTolerance_rad = 1e-3;  // a trajectory must start where the arm is
+
+// Flattens an Eigen matrix row-major (the stream's C order).
+template <class Matrix>
+std::vector<double> row_major(const Matrix& m) {
+  std::vector<double> v;
+  for (int r = 0; r < m.rows(); ++r)
+    for (int c = 0; c < m.cols(); ++c) v.push_back(m(r, c));
+  return v;
+}
+
+}  // namespace
+
+std::vector<std::string> camera_names() { return {"front", "wrist", "overhead"}; }
+
+Eigen::Isometry3d camera_pose(const std::string& name, const sim::World& world) {
+  const double table = world.layout().table_height_m;
+  if (name == "front")  // across the table, facing the robot, as RLBench's front camera
+    return render::look_at({0.95, 0.0, table + 0.6}, {0.1, 0.0, table});
+  if (name == "overhead")  // over the robot's shoulder
+    return render::look_at({-0.45, 0.45, table + 0.85}, {0.15, 0.0, table});
+  if (name == "wrist") {  // on the gripper, looking along the fingers
+    Eigen::Isometry3d tcp = world.tcp_pose();
+    Eigen::Isometry3d camera = tcp;
+    camera.translation() = tcp * Eigen::Vector3d(0.06, 0, -0.12);
+    camera.linear() = tcp.linear() * Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ());
+    return camera;
+  }
+  std::string known;
+  for (const auto& n : camera_names()) known += (known.empty() ? "" : ", ") + n;
+  throw Error("unknown camera '" + name + "' (known cameras: " + known + ")");
+}
+
+Simulator::Simulator(const robot::RobotModel& robot, SimulatorOptions options)
+    : robot_(robot), options_(std::move(options)) {
+  for (const auto& c : options_.cameras) {
+    bool known = false;
+    for (const auto& n : camera_names()) known |= n == c.name;
+    if (!known) camera_pose(c.name, sim::World(robot_));  // throws the listing error
+  }
+}
+
+Simulator::~Simulator() = default;
+
+stream::Record Simulator::observe(const std::string& failure) {
+  stream::Record obs("obs");
+  for (const auto& camera : options_.cameras) {
+    const render::CameraFrame frame =
+        render::render(world_->collision_world(), camera.intrinsics, camera_pose(camera.name, *world_),
+                       camera.name, options_.render_threads);
+    const int64_t h = frame.rgb.rows, w = frame.rgb.cols;
+    const std::string& n = camera.name;
+    const bool z = options_.compress_images;
+    obs.set<uint8_t>(n + ".rgb", {h, w, 3}, frame.rgb.ptr<uint8_t>(), z);
+    obs.set<float>(n + ".depth", {h, w}, frame.depth.ptr<float>(), z);
+    if (options_.point_clouds) obs.set<float>(n + ".points", {h, w, 3}, frame.points.ptr<float>(), z);
+    obs.set<double>(n + ".intrinsics", {3, 3}, row_major(frame.intrinsics));
+    obs.set<double>(n + ".extrinsics", {4, 4}, row_major(frame.world_from_camera.matrix()));
+  }
+  const robot::JointVector& q = world_->joint_positions();
+  obs.set<double>("joint_positions", {7}, q.data());
+  obs.set<double>("joint_velocities", {7}, velocity_.data());
+  const Eigen::Isometry3d tcp = world_->tcp_pose();
+  const Eigen::Quaterniond rotation(tcp.linear());
+  const std::vector<double> pose = {tcp.translation().x(), tcp.translation().y(), tcp.translation().z(),
+                                    rotation.x(), rotation.y(), rotation.z(), rotation.w()};
+  obs.set<double>("gripper_pose", {7}, pose);
+  obs.set_scalar<uint8_t>("gripper_open", world_->gripper_open());
+  obs.set_scalar<double>("gripper_opening_m", world_->finger_opening_m());
+  obs.set_scalar<int32_t>("step", step_);
+  obs.set_scalar<int32_t>("frame", frame_++);
+  obs.set_scalar<double>("time_s", time_s_);
+  obs.set_scalar<float>("reward", success_ ? tasks::Task::kSuccessReward : 0.0f);
+  obs.set_scalar<uint8_t>("terminal", terminal_);
+  obs.set_scalar<uint8_t>("success", success_);
+  obs.set_string("task", task_name_);
+  obs.set_scalar<int32_t>("variation", variation_);
+  obs.set_scalar<int64_t>("episode_seed", episode_seed_);
+  obs.set_string("description", task_->description(variation_));
+  if (!failure.empty()) obs.set_string("failure", failure);
+  return obs;
+}
+
+void Simulator::handle(const stream::Record& record,
+                       const std::function<void(const stream::Record&)>& emit) {
+  if (record.type() == "reset") reset(record, emit);
+  else if (record.type() == "trajectory") execute(record, emit);
+}
+
+void Simulator::reset(const stream::Record& record,
+                      const std::function<void(const stream::Record&)>& emit) {
+  task_name_ = record.string("task");
+  task_ = tasks::make_task(task_name_);
+  variation_ = record.has("variation") ? record.scalar<int32_t>("variation") : 0;
+  if (variation_ < 0 || variation_ >= task_->variation_count())
+    record.fail("variation", "0 to " + std::to_string(task_->variation_count() - 1) + " for " +
+                                 task_name_ + ", got " + std::to_string(variation_));
+  episode_seed_ = record.has("seed") ? record.scalar<int64_t>("seed") : 0;
+  world_ = std::make_unique<sim::World>(robot_);
+  std::mt19937_64 rng(static_cast<uint64_t>(episode_seed_));
+  task_->build(*world_, variation_, rng);
+  world_->settle(0.25);  // objects come to rest before the first image
+  step_ = frame_ = 0;
+  time_s_ = 0;
+  terminal_ = success_ = false;
+  velocity_.setZero();
+  emit(observe());
+}
+
+std::string Simulator::check_trajectory(const stream::Record& record) const {
+  if (record.has("failure")) return record.string("failure");
+  const auto times = record.array<double>("time_s");
+  const auto joints = record.array<double>("joint_positions");
+  const int64_t n = times.size();
+  if (n < 1 || joints.shape != stream::Shape{n, robot::kArmJoints})
+    record.fail("joint_positions", "float64 [N, 7] with N = " + std::to_string(n) +
+                                       " (the length of time_s), got " + stream::shape_to_string(joints.shape));
+  for (int64_t i = 0; i < n * robot::kArmJoints; ++i)
+    if (!std::isfinite(joints[i])) return "invalid_trajectory:not_finite";
+  for (int64_t i = 0; i < n; ++i)
+    if (!std::isfinite(times[i]) || (i > 0 && times[i] <= times[i - 1]) || (i == 0 && times[0] != 0))
+      return "invalid_trajectory:time_s must start at 0 and increase";
+  const robot::JointVector lo = robot_.lower_limits(), hi = robot_.upper_limits(),
+                           vmax = robot_.max_velocities();
+  for (int k = 0; k < robot::kArmJoints; ++k)
+    if (std::abs(joints[k] - world_->joint_positions()[k]) > kStartTolerance_rad)
+      return "invalid_trajectory:does not start at the current joint positions";
+  for (int64_t i = 0; i < n; ++i)
+    for (int k = 0; k < robot::kArmJoints; ++k) {
+      const double q = joints[i * robot::kArmJoints + k];
+      if (q < lo[k] - 1e-9 || q > hi[k] + 1e-9) return "joint_limits:joint" + std::to_string(k + 1);
+      if (i > 0) {
+        const double v = std::abs(q - joints[(i - 1) * robot::kArmJoints + k]) / (times[i] - times[i - 1]);
+        if (v > vmax[k] * 1.01) return "velocity_limit:joint" + std::to_string(k + 1);
+      }
+    }
+  return "";
+}
+
+void Simulator::execute(const stream::Record& record,
+                        const std::function<void(const stream::Record&)>& emit) {
+  if (!world_) throw StreamError(record.position, "trajectory before any reset: expected a reset record first");
+  if (terminal_)
+    throw StreamError(record.position, "trajectory after the episode ended: expected a reset record");
+  step_ += 1;
+  std::string failure = check_trajectory(record);
+  if (failure.empty()) {
+    const auto times = record.array<double>("time_s");
+    const auto joints = record.array<double>("joint_positions");
+    const int64_t n = times.size();
+    // Sample the piecewise-linear trajectory at the control period; physics runs in between.
+    const double duration = times[n - 1];
+    const int control_steps = std::max(1, static_cast<int>(std::ceil(duration / options_.control_period_s - 1e-9)));
+    int64_t segment = 0;
+    double previous_t = 0;
+    for (int s = 1; s <= control_steps && failure.empty(); ++s) {
+      const double t = std::min(duration, s * options_.control_period_s);
+      while (segment + 1 < n - 1 && times[segment + 1] < t) ++segment;
+      robot::JointVector q;
+      if (n == 1) {
+        q = Eigen::Map<const robot::JointVector>(&joints[0]);
+      } else {
+        const double a = (t - times[segment]) / (times[segment + 1] - times[segment]);
+        for (int k = 0; k < robot::kArmJoints; ++k)
+          q[k] = joints[segment * 7 + k] + std::clamp(a, 0.0, 1.0) * (joints[(segment + 1) * 7 + k] - joints[segment * 7 + k]);
+      }
+      const double dt = t - previous_t;
+      previous_t = t;
+      const robot::JointVector before = world_->joint_positions();
+      world_->step_towards(q, world_->finger_opening_m(), dt);
+      velocity_ = (q - before) / std::max(dt, 1e-9);
+      time_s_ += dt;
+      failure = world_->robot_collision();
+      if (options_.observe_every_step && failure.empty() && s < control_steps) emit(observe());
+    }
+    velocity_.setZero();
+    if (failure.empty() && record.has("gripper_open")) {
+      const bool open = record.scalar<uint8_t>("gripper_open") != 0;
+      const bool is_open = world_->gripper_open();
+      if (open && !is_open) world_->open_gripper();
+      if (!open && is_open) world_->close_gripper();
+      if (open != is_open) time_s_ += 0.25;
+    }
+  }
+  success_ = failure.empty() && task_->success(*world_);
+  terminal_ = success_ || !failure.empty() || step_ >= tasks::Task::kEpisodeLength;
+  emit(observe(failure));
+}
+
+stream::Record plan_reset(const EpisodePlan& plan, int index) {
+  const uint64_t seed = derive_seed(plan.seed, static_cast<uint64_t>(index));
+  int variation = plan.variation;
+  if (variation < 0) variation = static_cast<int>(seed % tasks::make_task(plan.task)->variation_count());
+  stream::Record reset("reset");
+  reset.set_string("task", plan.task);
+  reset.set_scalar<int32_t>("variation", variation);
+  reset.set_scalar<int64_t>("seed", static_cast<int64_t>(seed));
+  reset.set_scalar<int32_t>("episode", index);
+  return reset;
+}
+
+void run_filter(Simulator& simulator, const std::optional<EpisodePlan>& plan,
+                const std::function<std::optional<stream::Record>()>& next_input,
+                const std::function<void(const stream::Record&)>& emit) {
+  int started = 0;
+  if (plan) simulator.handle(plan_reset(*plan, started++), emit);
+  while (!plan || !simulator.episode_over() || started < plan->episodes) {
+    if (plan && simulator.episode_over()) {
+      simulator.handle(plan_reset(*plan, started++), emit);
+      continue;
+    }
+    auto record = next_input();
+    if (!record) break;
+    simulator.handle(*record, emit);
+  }
+}
+
+}  // namespace qte::simulator

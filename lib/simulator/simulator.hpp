@@ -1,0 +1,95 @@
+// The sim-step loop as a library: `reset` and `trajectory` records in, `obs` records out.
+// A trajectory is executed at the physics rate; its gripper command is applied at the end.
+// Anything wrong with an action (limits, collisions, a planner failure) ends the episode with
+// reward 0 and the reason in the observation, as an invalid action does in RLBench.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "render/camera.hpp"
+#include "robot/robot_model.hpp"
+#include "sim/world.hpp"
+#include "stream/record.hpp"
+#include "tasks/task.hpp"
+
+namespace qte::simulator {
+
+struct CameraSpec {
+  std::string name;              // "front", "wrist", "overhead"
+  render::CameraIntrinsics intrinsics;
+};
+
+struct SimulatorOptions {
+  std::vector<CameraSpec> cameras = {{"front", {}}};
+  bool point_clouds = true;           // include <camera>.points in observations
+  bool observe_every_step = false;    // also emit an obs at every control step of a trajectory
+  double control_period_s = 0.05;     // 20 Hz control steps along trajectories
+  int render_threads = 2;
+  bool compress_images = false;       // zstd on rgb/depth/points (for files on disk)
+};
+
+// The camera poses of the scene layout (front: facing the robot across the table).
+Eigen::Isometry3d camera_pose(const std::string& name, const sim::World& world);
+std::vector<std::string> camera_names();
+
+class Simulator {
+ public:
+  Simulator(const robot::RobotModel& robot, SimulatorOptions options);
+  ~Simulator();
+
+  // Consumes one record; `emit` receives each observation produced. Records other than
+  // reset and trajectory produce nothing. Protocol errors (a trajectory before any reset,
+  // or after the episode ended) throw StreamError naming the record.
+  void handle(const stream::Record& record, const std::function<void(const stream::Record&)>& emit);
+
+  bool episode_over() const { return terminal_; }
+
+  // For tests and tools that drive the world directly.
+  sim::World* world() { return world_.get(); }
+  const tasks::Task* task() const { return task_.get(); }
+
+ private:
+  stream::Record observe(const std::string& failure = "");
+  void reset(const stream::Record& record, const std::function<void(const stream::Record&)>& emit);
+  void execute(const stream::Record& record, const std::function<void(const stream::Record&)>& emit);
+  std::string check_trajectory(const stream::Record& record) const;
+
+  const robot::RobotModel& robot_;
+  SimulatorOptions options_;
+  std::unique_ptr<sim::World> world_;
+  std::unique_ptr<tasks::Task> task_;
+  std::string task_name_;
+  int variation_ = 0;
+  int64_t episode_seed_ = 0;
+  int step_ = 0;    // next-best poses executed in this episode
+  int frame_ = 0;   // observations emitted in this episode
+  double time_s_ = 0;
+  bool terminal_ = true;
+  bool success_ = false;
+  robot::JointVector velocity_ = robot::JointVector::Zero();
+};
+
+// What sim-step runs by itself: episodes of one task, each reset from its own seed.
+struct EpisodePlan {
+  std::string task;
+  int variation = 0;  // -1: drawn per episode from its seed
+  int episodes = 1;
+  uint64_t seed = 0;
+};
+
+// The reset record of episode `index` of a plan (seed derived from plan.seed and index).
+stream::Record plan_reset(const EpisodePlan& plan, int index);
+
+// The sim-step filter: with a plan, starts its first episode at once and the next one after
+// each terminal observation, stopping after plan.episodes; records read from `next_input`
+// (until it returns nothing) drive the episodes. Observations go to `emit`.
+void run_filter(Simulator& simulator, const std::optional<EpisodePlan>& plan,
+                const std::function<std::optional<stream::Record>()>& next_input,
+                const std::function<void(const stream::Record&)>& emit);
+
+}  // namespace qte::simulator

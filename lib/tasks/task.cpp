@@ -1,0 +1,73 @@
+#include "tasks/task.hpp"
+
+#include <algorithm>
+
+#include "common/error.hpp"
+#include "tasks/catalogue.hpp"
+
+namespace qte::tasks {
+
+std::vector<std::string> task_names() { return {"reach_target", "pick_and_lift", "lift_numbered_block"}; }
+
+std::unique_ptr<Task> make_task(const std::string& name) {
+  if (name == "reach_target") return make_reach_target();
+  if (name == "pick_and_lift") return make_pick_and_lift();
+  if (name == "lift_numbered_block") return make_lift_numbered_block();
+  std::string known;
+  for (const auto& n : task_names()) known += (known.empty() ? "" : ", ") + n;
+  throw Error("unknown task '" + name + "' (known tasks: " + known + ")");
+}
+
+Eigen::Matrix3d top_down(double yaw_rad) {
+  // TCP z down (rotate pi about x), then yaw about world z; TCP y is the closing axis.
+  return (Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+const std::vector<NamedColour>& colours() {
+  // RLBench's colour list, so variations mean the same thing.
+  static const std::vector<NamedColour> list = {
+      {"red", {1.0f, 0.0f, 0.0f}},      {"maroon", {0.5f, 0.0f, 0.0f}},
+      {"lime", {0.0f, 1.0f, 0.0f}},     {"green", {0.0f, 0.5f, 0.0f}},
+      {"blue", {0.0f, 0.0f, 1.0f}},     {"navy", {0.0f, 0.0f, 0.5f}},
+      {"yellow", {1.0f, 1.0f, 0.0f}},   {"cyan", {0.0f, 1.0f, 1.0f}},
+      {"magenta", {1.0f, 0.0f, 1.0f}},  {"silver", {0.75f, 0.75f, 0.75f}},
+      {"gray", {0.5f, 0.5f, 0.5f}},     {"orange", {1.0f, 0.5f, 0.0f}},
+      {"olive", {0.5f, 0.5f, 0.0f}},    {"purple", {0.5f, 0.0f, 0.5f}},
+      {"teal", {0.0f, 0.5f, 0.5f}},     {"azure", {0.0f, 0.5f, 1.0f}},
+      {"violet", {0.5f, 0.0f, 1.0f}},   {"rose", {1.0f, 0.0f, 0.5f}},
+      {"black", {0.0f, 0.0f, 0.0f}},    {"white", {1.0f, 1.0f, 1.0f}},
+  };
+  return list;
+}
+
+std::vector<Eigen::Vector3d> sample_separated(std::mt19937_64& rng, int count,
+                                              const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                                              double min_distance_m) {
+  for (int attempt = 0; attempt < 1000; ++attempt) {
+    std::vector<Eigen::Vector3d> points;
+    for (int i = 0; i < count; ++i) {
+      Eigen::Vector3d p;
+      for (int k = 0; k < 3; ++k) p[k] = std::uniform_real_distribution<double>(lo[k], hi[k])(rng);
+      points.push_back(p);
+    }
+    bool ok = true;
+    for (int i = 0; i < count && ok; ++i)
+      for (int j = i + 1; j < count && ok; ++j) ok = (points[i] - points[j]).norm() >= min_distance_m;
+    if (ok) return points;
+  }
+  throw Error("cannot place " + std::to_string(count) + " objects " +
+              std::to_string(min_distance_m) + " m apart in the task region");
+}
+
+std::vector<int> pick_distinct(std::mt19937_64& rng, int count, int range, int excluded) {
+  std::vector<int> out;
+  while (static_cast<int>(out.size()) < count) {
+    const int c = std::uniform_int_distribution<int>(0, range - 1)(rng);
+    if (c != excluded && std::find(out.begin(), out.end(), c) == out.end()) out.push_back(c);
+  }
+  return out;
+}
+
+}  // namespace qte::tasks

@@ -1,0 +1,47 @@
+// A task: the objects of a scene and how they are randomised (from a seed and a variation),
+// when it is solved, and a scripted expert as next-best poses (RLBench's waypoints).
+#pragma once
+
+#include <Eigen/Geometry>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "sim/world.hpp"
+
+namespace qte::tasks {
+
+// One next-best pose of the expert: where the TCP goes (world frame), the gripper state
+// after arriving, and whether the planner may ignore collisions (straight approach moves).
+struct Waypoint {
+  Eigen::Isometry3d tcp_pose = Eigen::Isometry3d::Identity();
+  bool gripper_open = true;
+  bool ignore_collisions = false;
+};
+
+class Task {
+ public:
+  virtual ~Task() = default;
+  virtual std::string name() const = 0;
+  virtual int variation_count() const = 0;
+  // In words, for people and logs, e.g. "lift the block numbered 2".
+  virtual std::string description(int variation) const = 0;
+  // Adds the task's objects to an empty world, randomised by `rng`.
+  virtual void build(sim::World& world, int variation, std::mt19937_64& rng) = 0;
+  virtual bool success(const sim::World& world) const = 0;
+  virtual std::vector<Waypoint> expert_waypoints(const sim::World& world) const = 0;
+
+  static constexpr int kEpisodeLength = 10;  // next-best poses per episode
+  static constexpr float kSuccessReward = 100.0f;
+};
+
+// The tasks by name; an unknown name is an Error listing the known ones.
+std::unique_ptr<Task> make_task(const std::string& name);
+std::vector<std::string> task_names();
+
+// A top-down gripper orientation (TCP z pointing down) with the fingers closing along the
+// world direction at angle `yaw_rad` about z.
+Eigen::Matrix3d top_down(double yaw_rad);
+
+}  // namespace qte::tasks

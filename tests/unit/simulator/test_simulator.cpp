@@ -1,0 +1,198 @@
+// The sim-step loop: resets, trajectories, failures, determinism and the tasks' experts.
+#include <gtest/gtest.h>
+
+#include "trajectory_helpers.hpp"
+#include "stream/codec.hpp"
+#include "tasks/task.hpp"
+
+using namespace qte;
+using namespace qte::simulator;
+
+namespace {
+
+const robot::RobotModel& xarm() {
+  static const robot::RobotModel robot = robot::RobotModel::xarm7();
+  return robot;
+}
+
+SimulatorOptions small_options() {
+  SimulatorOptions options;
+  options.cameras = {{"front", {}}};
+  options.cameras[0].intrinsics.width = options.cameras[0].intrinsics.height = 32;
+  options.render_threads = 1;
+  return options;
+}
+
+stream::Record reset_record(const std::string& task, int variation, int64_t seed) {
+  stream::Record r("reset");
+  r.set_string("task", task);
+  r.set_scalar<int32_t>("variation", variation);
+  r.set_scalar<int64_t>("seed", seed);
+  return r;
+}
+
+struct SimRun {
+  Simulator simulator{xarm(), small_options()};
+  std::vector<stream::Record> out;
+  void send(const stream::Record& r) {
+    simulator.handle(r, [&](const stream::Record& obs) { out.push_back(obs); });
+  }
+  const stream::Record& last() const { return out.back(); }
+};
+
+// Executes the task's expert with straight joint moves; returns the final observation.
+stream::Record run_expert(SimRun& run, const std::string& task, int variation, int64_t seed) {
+  run.send(reset_record(task, variation, seed));
+  for (const auto& waypoint : run.simulator.task()->expert_waypoints(*run.simulator.world())) {
+    sim::World& world = *run.simulator.world();
+    const robot::JointVector q = test_support::ik_world(world, waypoint.tcp_pose);
+    run.send(test_support::straight_trajectory(xarm(), world.joint_positions(), q, waypoint.gripper_open));
+    if (run.simulator.episode_over()) break;
+  }
+  return run.last();
+}
+
+}  // namespace
+
+TEST(Simulator, ResetWritesAFullObservation) {
+  SimRun run;
+  run.send(reset_record("reach_target", 0, 1));
+  ASSERT_EQ(run.out.size(), 1u);
+  const auto& obs = run.last();
+  EXPECT_EQ(obs.array<uint8_t>("front.rgb").shape, (stream::Shape{32, 32, 3}));
+  EXPECT_EQ(obs.array<float>("front.depth").shape, (stream::Shape{32, 32}));
+  EXPECT_EQ(obs.array<float>("front.points").shape, (stream::Shape{32, 32, 3}));
+  EXPECT_EQ(obs.array<double>("front.intrinsics").shape, (stream::Shape{3, 3}));
+  EXPECT_EQ(obs.array<double>("joint_positions").size(), 7);
+  EXPECT_EQ(obs.scalar<int32_t>("step"), 0);
+  EXPECT_EQ(obs.scalar<uint8_t>("terminal"), 0);
+  EXPECT_EQ(obs.scalar<uint8_t>("gripper_open"), 1);
+  EXPECT_EQ(obs.string("task"), "reach_target");
+}
+
+TEST(Simulator, SameSeedSameBytesOtherSeedOtherScene) {
+  auto bytes = [](int64_t seed) {
+    SimRun run;
+    run.send(reset_record("pick_and_lift", 2, seed));
+    return stream::encode_record(run.last());
+  };
+  EXPECT_EQ(bytes(7), bytes(7));
+  EXPECT_NE(bytes(7), bytes(8));
+}
+
+TEST(Simulator, UnknownTaskIsAnErrorListingTheTasks) {
+  SimRun run;
+  try {
+    run.send(reset_record("open_drawer", 0, 1));
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("known tasks: reach_target, pick_and_lift, lift_numbered_block"),
+              std::string::npos);
+  }
+}
+
+TEST(Simulator, BadTrajectoriesFailTheActionWithAReason) {
+  auto failure_of = [](const std::function<stream::Record(const sim::World&)>& make) {
+    SimRun run;
+    run.send(reset_record("reach_target", 0, 1));
+    run.send(make(*run.simulator.world()));
+    EXPECT_EQ(run.last().scalar<uint8_t>("terminal"), 1);
+    EXPECT_EQ(run.last().scalar<float>("reward"), 0.0f);
+    return run.last().has("failure") ? run.last().string("failure") : std::string("none");
+  };
+  const auto& robot = xarm();
+  // Not starting at the current joint positions.
+  EXPECT_NE(failure_of([&](const sim::World& w) {
+              robot::JointVector elsewhere = w.joint_positions();
+              elsewhere[0] += 0.3;
+              return test_support::straight_trajectory(robot, elsewhere, elsewhere, true);
+            }).find("does not start"), std::string::npos);
+  // NaN.
+  EXPECT_NE(failure_of([&](const sim::World& w) {
+              robot::JointVector q = w.joint_positions();
+              q[2] = NAN;
+              return test_support::straight_trajectory(robot, w.joint_positions(), q, true);
+            }).find("not_finite"), std::string::npos);
+  // Beyond a joint limit (joint 2: -118..120 deg).
+  EXPECT_EQ(failure_of([&](const sim::World& w) {
+              robot::JointVector q = w.joint_positions();
+              q[1] = 2.3;
+              return test_support::straight_trajectory(robot, w.joint_positions(), q, true);
+            }), "joint_limits:joint2");
+  // Into the table.
+  EXPECT_NE(failure_of([&](const sim::World& w) {
+              robot::JointVector q = w.joint_positions();
+              q[1] = 1.6;  // shoulder forward and down: the arm sweeps into the table
+              q[3] = 0.2;
+              return test_support::straight_trajectory(robot, w.joint_positions(), q, true);
+            }).find("-table"), std::string::npos);
+  // A planner failure passed on.
+  EXPECT_EQ(failure_of([](const sim::World&) {
+              stream::Record t("trajectory");
+              t.set_string("failure", "ik_failed");
+              return t;
+            }), "ik_failed");
+}
+
+TEST(Simulator, ProtocolErrorsNameTheRecord) {
+  SimRun run;
+  EXPECT_THROW(run.send(test_support::straight_trajectory(xarm(), robot::JointVector::Zero(),
+                                                     robot::JointVector::Zero(), true)),
+               StreamError);
+}
+
+TEST(Simulator, GraspHoldsThroughLiftingAndOpeningReleases) {
+  SimRun run;
+  run.send(reset_record("pick_and_lift", 0, 3));
+  sim::World& world = *run.simulator.world();
+  const auto waypoints = run.simulator.task()->expert_waypoints(world);
+  const int block = world.object_id("target");
+  const double z0 = world.object_pose(block).translation().z();
+  for (int i = 0; i < 3; ++i)  // above, grasp (close), lift
+    run.send(test_support::straight_trajectory(xarm(), world.joint_positions(),
+                                          test_support::ik_world(world, waypoints[i].tcp_pose),
+                                          waypoints[i].gripper_open));
+  EXPECT_EQ(world.held_object(), block);
+  EXPECT_NEAR(world.object_pose(block).translation().z(), z0 + 0.15, 0.01);
+  EXPECT_LT(world.finger_opening_m(), 0.06);  // fingers stopped on the 5 cm block
+  EXPECT_GT(world.finger_opening_m(), 0.045);
+  world.open_gripper();
+  world.settle(1.0);
+  EXPECT_EQ(world.held_object(), -1);
+  EXPECT_NEAR(world.object_pose(block).translation().z(), z0, 0.005);  // fell back to the table
+}
+
+TEST(Simulator, ObjectsArePushedByTheArm) {
+  SimRun run;
+  run.send(reset_record("pick_and_lift", 0, 3));
+  sim::World& world = *run.simulator.world();
+  const int block = world.object_id("distractor1");
+  const Eigen::Isometry3d start = world.object_pose(block);
+  // Sweep the closed gripper through the block at half its height, along world y.
+  Eigen::Isometry3d tcp = Eigen::Isometry3d::Identity();
+  tcp.linear() = tasks::top_down(0);
+  tcp.translation() = start.translation() + Eigen::Vector3d(0, -0.08, 0.0);
+  world.close_gripper();
+  run.send(test_support::straight_trajectory(xarm(), world.joint_positions(), test_support::ik_world(world, tcp), false));
+  tcp.translation().y() += 0.16;
+  run.send(test_support::straight_trajectory(xarm(), world.joint_positions(), test_support::ik_world(world, tcp), false));
+  world.settle(0.5);
+  EXPECT_GT((world.object_pose(block).translation() - start.translation()).norm(), 0.03);
+}
+
+class ExpertSolves : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(ExpertSolves, SeveralSeeds) {
+  for (int64_t seed = 0; seed < 5; ++seed) {
+    SimRun run;
+    const int variation = static_cast<int>(seed % 3);
+    const auto obs = run_expert(run, GetParam(), variation, seed);
+    EXPECT_EQ(obs.scalar<uint8_t>("success"), 1)
+        << GetParam() << " seed " << seed << (obs.has("failure") ? " failure " + obs.string("failure") : "");
+    EXPECT_EQ(obs.scalar<float>("reward"), 100.0f);
+    EXPECT_EQ(obs.scalar<uint8_t>("terminal"), 1);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Tasks, ExpertSolves,
+                         ::testing::Values("reach_target", "pick_and_lift", "lift_numbered_block"));

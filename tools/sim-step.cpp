@@ -1,0 +1,106 @@
+// sim-step: the simulator as a filter: reset and trajectory records in, observations out.
+#include <sstream>
+
+#include "cli/command.hpp"
+#include "simulator/simulator.hpp"
+#include "stream/reader.hpp"
+#include "stream/writer.hpp"
+
+using namespace qte;
+
+static cli::Usage usage() {
+  cli::Usage u;
+  u.name = "sim-step";
+  u.summary = "simulate the xArm 7 and a task in Bullet: trajectories in, RGB-D observations out";
+  u.description = {
+      "A long-running filter around a Bullet world: a table, the UFACTORY xArm 7 with its "
+      "parallel gripper (lib/robot/xarm7.urdf), and the objects of a task. It reads 'reset' "
+      "records (task, variation, seed) and 'trajectory' records (time-stamped joint waypoints "
+      "and a gripper command, as plan-path writes them) and writes an 'obs' record after each: "
+      "every camera's RGB, metric depth, intrinsics, extrinsics and world-frame point cloud; "
+      "joint positions and velocities, gripper open flag and pose, step index; reward (100 on "
+      "success), terminal, success, and the failure reason of the last action if any.",
+      "A trajectory that does not start at the current joint positions, holds NaNs, leaves the "
+      "joint limits, exceeds the joint speed limit, or makes the arm touch the table or itself "
+      "fails: the episode ends with reward 0 and the reason in the observation's 'failure' "
+      "field, as an invalid action does in RLBench. An episode also ends after 10 next-best "
+      "poses. With --task, sim-step starts episodes by itself (the next one after each terminal "
+      "observation) until --episodes have run; reset records on the input start one at any "
+      "time. Other record types are ignored.",
+      "Cameras are rendered without a GPU, one ray per pixel against Bullet's collision world, "
+      "with per-object colours, diffuse shading and textures (the digits of "
+      "lift_numbered_block). Tasks: reach_target, pick_and_lift, lift_numbered_block.",
+  };
+  u.arguments = {{"FILE", "input records; '-' or absent is standard input", true, false}};
+  u.options = {
+      {"task", "T", "run episodes of task T by itself (see --episodes)", ""},
+      {"episodes", "N", "episodes to run with --task", "1"},
+      {"variation", "V", "task variation with --task, or 'random' for one per episode", "0"},
+      {"cameras", "LIST", "comma-separated cameras: front, wrist, overhead", "front"},
+      {"image-size", "WxH", "camera resolution, e.g. 128x128 or 256x256", "128x128"},
+      {"every-step", "", "also write an observation at every 50 ms control step of a trajectory "
+                         "(full demonstrations)", ""},
+      {"no-points", "", "leave the world-frame point clouds out of observations", ""},
+      {"compress", "", "zstd-compress images and point clouds (for files on disk)", ""},
+      {"threads", "N", "rendering threads", "2"},
+      {"output", "FILE", "where to write; '-' is standard output", "-"},
+  };
+  u.uses_randomness = true;
+  u.examples = {
+      {"sim-step --task reach_target --seed 3 < /dev/null | stream-png --dir frames/",
+       "one reset, its first front image saved as PNG"},
+      {"sim-step --task pick_and_lift --episodes 100 < fifo | voxelize | qte-select --model m.rec | plan-path > fifo",
+       "an actor: the learning loop closed by a FIFO"},
+      {"stream-pack reset task=lift_numbered_block variation:i32=1 seed:i64=5 | sim-step --image-size 256x256",
+       "one explicit reset, 256x256 images"},
+  };
+  u.see_also = {"qte-stream(5)", "plan-path(1)", "stream-png(1)", "stream-dump(1)"};
+  return u;
+}
+
+static render::CameraIntrinsics parse_size(const std::string& text) {
+  render::CameraIntrinsics intrinsics;
+  char x = 0;
+  std::istringstream in(text);
+  if (!(in >> intrinsics.width >> x >> intrinsics.height) || x != 'x' || !in.eof() ||
+      intrinsics.width < 8 || intrinsics.height < 8 || intrinsics.width > 4096 || intrinsics.height > 4096)
+    throw UsageError("--image-size: expected WxH between 8x8 and 4096x4096, got '" + text + "'");
+  return intrinsics;
+}
+
+static void run(const cli::Arguments& args) {
+  simulator::SimulatorOptions options;
+  options.cameras.clear();
+  const render::CameraIntrinsics intrinsics = parse_size(args.text("image-size"));
+  std::istringstream names(args.text("cameras"));
+  for (std::string name; std::getline(names, name, ',');) options.cameras.push_back({name, intrinsics});
+  options.observe_every_step = args.flag("every-step");
+  options.point_clouds = !args.flag("no-points");
+  options.compress_images = args.flag("compress");
+  options.render_threads = static_cast<int>(args.integer("threads"));
+  if (options.render_threads < 1) throw UsageError("--threads must be at least 1");
+
+  const robot::RobotModel robot = robot::RobotModel::xarm7();
+  simulator::Simulator simulator(robot, options);
+  std::optional<simulator::EpisodePlan> plan;
+  if (args.has("task")) {
+    plan = simulator::EpisodePlan{args.text("task"), 0, static_cast<int>(args.integer("episodes")), args.seed()};
+    plan->variation = args.text("variation") == "random" ? -1 : static_cast<int>(args.integer("variation"));
+    tasks::make_task(plan->task);  // an unknown task fails before anything is written
+  }
+  const std::string input = args.positional().empty() ? "-" : args.positional()[0];
+  std::unique_ptr<stream::RecordReader> reader;
+  stream::RecordWriter writer(args.text("output"));
+  simulator::run_filter(
+      simulator, plan,
+      [&]() -> std::optional<stream::Record> {
+        // Opened on demand: opening a FIFO blocks until its writer appears, and in the actor
+        // loop that writer waits for our first observation.
+        if (!reader) reader = std::make_unique<stream::RecordReader>(input);
+        return reader->next();
+      },
+      [&](const stream::Record& obs) { writer.write(obs); });
+  writer.close();
+}
+
+int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }
