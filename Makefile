@@ -65,7 +65,7 @@ man: build
 	for t in $(TOOLS); do $(BUILD)/tools/$$t --help-man > man/$$t.1; done
 
 bench: build
-	@echo "benchmarks arrive with the simulator and learner issues"
+	@for b in $(BUILD)/tests/bench/bench_*; do echo "== $$(basename $$b)"; $$b; done
 
 clean:
 	rm -rf $(BUILD) $(BUILD)-asan $(BUILD)-fuzz

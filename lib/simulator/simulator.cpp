@@ -26,9 +26,9 @@ std::vector<std::string> camera_names() { return {"front", "wrist", "overhead"};
 Eigen::Isometry3d camera_pose(const std::string& name, const sim::World& world) {
   const double table = world.layout().table_height_m;
   if (name == "front")  // across the table, facing the robot, as RLBench's front camera
-    return render::look_at({0.95, 0.0, table + 0.6}, {0.1, 0.0, table});
+    return render::look_at({1.05, 0.0, table + 0.85}, {0.0, 0.0, table + 0.05});
   if (name == "overhead")  // over the robot's shoulder
-    return render::look_at({-0.45, 0.45, table + 0.85}, {0.15, 0.0, table});
+    return render::look_at({-0.5, 0.8, table + 1.0}, {0.15, 0.0, table});
   if (name == "wrist") {  // on the gripper, looking along the fingers
     Eigen::Isometry3d tcp = world.tcp_pose();
     Eigen::Isometry3d camera = tcp;

@@ -134,6 +134,22 @@ TEST(Simulator, BadTrajectoriesFailTheActionWithAReason) {
             }), "ik_failed");
 }
 
+TEST(Simulator, SelfCollisionFailsTheAction) {
+  SimRun run;
+  run.send(reset_record("reach_target", 0, 1));
+  sim::World& world = *run.simulator.world();
+  // Elbow folded far back (joint 4 at 194 deg) with the wrist bent back (joint 6 at 174
+  // deg): the wrist comes down onto the forearm.
+  robot::JointVector q;
+  q << 0, -0.01, 0, 3.39, 0, 3.04, 0;
+  run.send(test_support::straight_trajectory(xarm(), world.joint_positions(), q, true));
+  ASSERT_TRUE(run.last().has("failure"));
+  const std::string failure = run.last().string("failure");
+  EXPECT_EQ(failure.rfind("collision:", 0), 0u) << failure;
+  EXPECT_EQ(failure.find("table"), std::string::npos) << failure;
+  EXPECT_EQ(run.last().scalar<uint8_t>("terminal"), 1);
+}
+
 TEST(Simulator, ProtocolErrorsNameTheRecord) {
   SimRun run;
   EXPECT_THROW(run.send(test_support::straight_trajectory(xarm(), robot::JointVector::Zero(),
@@ -148,12 +164,22 @@ TEST(Simulator, GraspHoldsThroughLiftingAndOpeningReleases) {
   const auto waypoints = run.simulator.task()->expert_waypoints(world);
   const int block = world.object_id("target");
   const double z0 = world.object_pose(block).translation().z();
-  for (int i = 0; i < 3; ++i)  // above, grasp (close), lift
+  for (int i = 0; i < 2; ++i)  // above, grasp (close)
     run.send(test_support::straight_trajectory(xarm(), world.joint_positions(),
-                                          test_support::ik_world(world, waypoints[i].tcp_pose),
-                                          waypoints[i].gripper_open));
+                                               test_support::ik_world(world, waypoints[i].tcp_pose),
+                                               waypoints[i].gripper_open));
+  // Lift by 20 cm, then carry it 10 cm sideways.
+  Eigen::Isometry3d lifted = waypoints[1].tcp_pose;
+  lifted.translation().z() += 0.20;
+  run.send(test_support::straight_trajectory(xarm(), world.joint_positions(),
+                                             test_support::ik_world(world, lifted), false));
   EXPECT_EQ(world.held_object(), block);
-  EXPECT_NEAR(world.object_pose(block).translation().z(), z0 + 0.15, 0.01);
+  EXPECT_NEAR(world.object_pose(block).translation().z(), z0 + 0.20, 0.005);
+  lifted.translation().y() += 0.10;
+  run.send(test_support::straight_trajectory(xarm(), world.joint_positions(),
+                                             test_support::ik_world(world, lifted), false));
+  EXPECT_EQ(world.held_object(), block);
+  EXPECT_NEAR((world.object_pose(block).translation() - lifted.translation()).norm(), 0.0, 0.005);
   EXPECT_LT(world.finger_opening_m(), 0.06);  // fingers stopped on the 5 cm block
   EXPECT_GT(world.finger_opening_m(), 0.045);
   world.open_gripper();
