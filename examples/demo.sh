@@ -1,34 +1,38 @@
 #!/usr/bin/env bash
-# `make demo`: runs the toolkit's main job with the programs that exist so far, on real data,
-# and says what it did. (The full loop sim-step -> voxelize -> qte-select -> plan-path lands
-# with the simulator, planner and learner; this script grows with them.)
+# `make demo`: runs the toolkit's main job with the programs that exist so far, on the
+# built-in simulated tasks, and says what it did. The learning loop (voxelize, keyframe,
+# qattn-train, qte-select, plan-path, demo-record) lands with its issues; this script grows
+# with them.
 set -euo pipefail
 out=${QTE_DEMO_DIR:-out/demo}
-mkdir -p "$out"
+rm -rf "$out" && mkdir -p "$out"
 say() { printf '\n== %s\n' "$*" >&2; }
 
-say "1. write a reset record and an observation-like record (stream-pack)"
-stream-pack reset task=reach_target variation:i32=0 seed:i64=7 > "$out/episode.rec"
-# A synthetic 128x128 camera frame as NumPy arrays (Debian's python3 has NumPy).
-/usr/bin/python3 - "$out" <<'PY'
-import sys, numpy as np
-out = sys.argv[1]
-y, x = np.mgrid[0:128, 0:128]
-np.save(f"{out}/front_rgb.npy", np.stack([x * 2, y * 2, np.full_like(x, 128)], -1).astype(np.uint8))
-np.save(f"{out}/front_depth.npy", (1.0 + 0.002 * x).astype(np.float32))
-PY
-stream-pack obs front.rgb=@"$out/front_rgb.npy" front.depth=@"$out/front_depth.npy" \
-  step:i32=0 reward:f32=0 terminal:u8=0 --compress --output "$out/obs.rec"
+say "1. one episode start per task: the simulator's observations (sim-step), as PNG (stream-png)"
+for task in reach_target pick_and_lift lift_numbered_block; do
+  sim-step --task "$task" --seed 1 --image-size 256x256 --cameras front,wrist,overhead \
+    --output "$out/$task.rec" < /dev/null
+  stream-png --depth --dir "$out/$task" "$out/$task.rec"
+  echo "$task: $(stream-dump --summary "$out/$task.rec")" >&2
+done
 
-say "2. join them into one stream through a pipe, checking every record (stream-cat)"
-stream-cat "$out/episode.rec" "$out/obs.rec" | stream-cat --output "$out/all.rec"
+say "2. a trajectory through a pipe: reset + joint waypoints in, an observation every 50 ms out"
+# From the ready pose, turn the base and lean forward over the table (radians, 2 s).
+ready="0,-0.35,0,0.75,0,1.1,0"
+lean="0.5,0.1,0,0.9,0,0.8,0"
+{ stream-pack reset task=pick_and_lift variation:i32=0 seed:i64=1
+  stream-pack trajectory time_s:f64=0,2 "joint_positions:f64[2,7]=$ready,$lean" gripper_open:u8=1
+} | sim-step --every-step --image-size 128x128 --output "$out/motion.rec"
+stream-png --every 8 --dir "$out/motion" "$out/motion.rec"
+stream-dump --type obs --values 3 "$out/motion.rec" > "$out/motion.txt"
+grep -E "^#|joint_positions|terminal|failure" "$out/motion.txt" | tail -6 >&2
 
-say "3. inspect it (stream-dump), export the arrays for NumPy (--npy)"
-stream-dump "$out/all.rec"
-stream-dump --summary "$out/all.rec"
-stream-dump --npy "$out/npy" --json "$out/all.rec" > "$out/all.jsonl"
+say "3. the format: any stream prints as text or JSON Lines, and exports to NumPy"
+stream-dump --json --values 2 "$out/motion.rec" > "$out/motion.jsonl"
+head -c 400 "$out/motion.jsonl" >&2; echo " ..." >&2
+stream-dump --npy "$out/npy" --type obs "$out/reach_target.rec" > /dev/null
 ls "$out/npy" >&2
 
-say "done: streams, JSON Lines and .npy files are in $out/"
-echo "The simulator, planner and learner stages (sim-step, plan-path, voxelize, keyframe," >&2
-echo "qattn-train, qte-select) are not built yet; this demo ran every stage that exists." >&2
+say "done: streams (.rec), PNG frames and .npy arrays are in $out/"
+echo "Ran: sim-step (Bullet + ray-cast cameras), stream-png, stream-pack, stream-dump." >&2
+echo "Not built yet: plan-path, demo-record, voxelize, keyframe, qattn-train, qte-select." >&2
