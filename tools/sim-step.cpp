@@ -1,6 +1,4 @@
 // sim-step: the simulator as a filter: reset and trajectory records in, observations out.
-#include <sstream>
-
 #include "cli/command.hpp"
 #include "simulator/simulator.hpp"
 #include "stream/reader.hpp"
@@ -58,22 +56,9 @@ static cli::Usage usage() {
   return u;
 }
 
-static render::CameraIntrinsics parse_size(const std::string& text) {
-  render::CameraIntrinsics intrinsics;
-  char x = 0;
-  std::istringstream in(text);
-  if (!(in >> intrinsics.width >> x >> intrinsics.height) || x != 'x' || !in.eof() ||
-      intrinsics.width < 8 || intrinsics.height < 8 || intrinsics.width > 4096 || intrinsics.height > 4096)
-    throw UsageError("--image-size: expected WxH between 8x8 and 4096x4096, got '" + text + "'");
-  return intrinsics;
-}
-
 static void run(const cli::Arguments& args) {
-  simulator::SimulatorOptions options;
-  options.cameras.clear();
-  const render::CameraIntrinsics intrinsics = parse_size(args.text("image-size"));
-  std::istringstream names(args.text("cameras"));
-  for (std::string name; std::getline(names, name, ',');) options.cameras.push_back({name, intrinsics});
+  simulator::SimulatorOptions options =
+      simulator::options_from_camera_arguments(args.text("cameras"), args.text("image-size"));
   options.observe_every_step = args.flag("every-step");
   options.point_clouds = !args.flag("no-points");
   options.compress_images = args.flag("compress");

@@ -157,6 +157,22 @@ JointVector RobotModel::max_velocities() const {
   return v;
 }
 
+std::vector<std::pair<int, int>> RobotModel::self_collision_pairs() const {
+  auto moving_joints_above = [&](int link) {
+    int depth = 0;
+    for (int j = links_[link].parent_joint; j >= 0; j = links_[joints_[j].parent_link].parent_joint)
+      if (joints_[j].type != Joint::Type::fixed && !joints_[j].finger) ++depth;
+    return depth;
+  };
+  std::vector<std::pair<int, int>> pairs;
+  for (int a = 0; a < static_cast<int>(links_.size()); ++a)
+    for (int b = a + 1; b < static_cast<int>(links_.size()); ++b)
+      if (!links_[a].shapes.empty() && !links_[b].shapes.empty() &&
+          std::abs(moving_joints_above(a) - moving_joints_above(b)) > 2)
+        pairs.emplace_back(a, b);
+  return pairs;
+}
+
 std::vector<Eigen::Isometry3d> RobotModel::link_poses(const JointVector& q,
                                                       double opening_m) const {
   std::vector<Eigen::Isometry3d> poses(links_.size(), Eigen::Isometry3d::Identity());

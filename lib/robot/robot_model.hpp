@@ -56,6 +56,11 @@ class RobotModel {
   JointVector max_velocities() const;
   double max_finger_opening_m() const { return max_opening_m_; }  // both fingers together
 
+  // Pairs of links (with collision shapes) that must not touch: links more than two moving
+  // joints apart. Neighbours overlap at their joints by construction; the fingers move with
+  // the gripper, so they count as one group with it.
+  std::vector<std::pair<int, int>> self_collision_pairs() const;
+
   // Pose of every link in the robot's base frame for arm joints `q` (rad) and a gripper
   // opening (distance between the fingers, m).
   std::vector<Eigen::Isometry3d> link_poses(const JointVector& q, double opening_m) const;

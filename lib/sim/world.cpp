@@ -153,20 +153,7 @@ World::World(const robot::RobotModel& robot, const SceneLayout& layout)
     }
     impl_->links.push_back(std::move(body));
   }
-  // Self-collision is checked between links more than two joints apart (neighbours overlap
-  // by construction at the joints); fingers and gripper form one rigid group.
-  const auto& joints = robot.joints();
-  auto depth_of = [&](int link) {
-    int d = 0;
-    for (int j = robot.links()[link].parent_joint; j >= 0; j = robot.links()[joints[j].parent_link].parent_joint)
-      if (joints[j].type != robot::Joint::Type::fixed && !joints[j].finger) ++d;
-    return d;
-  };
-  for (std::size_t a = 0; a < robot.links().size(); ++a)
-    for (std::size_t b = a + 1; b < robot.links().size(); ++b)
-      if (impl_->links[a].body && impl_->links[b].body &&
-          std::abs(depth_of(static_cast<int>(a)) - depth_of(static_cast<int>(b))) > 2)
-        impl_->checked_link_pairs.emplace_back(static_cast<int>(a), static_cast<int>(b));
+  impl_->checked_link_pairs = robot.self_collision_pairs();
 
   // Ready pose: the gripper above the table, pointing down, open.
   robot::JointVector ready;
@@ -175,12 +162,6 @@ World::World(const robot::RobotModel& robot, const SceneLayout& layout)
 }
 
 World::~World() = default;
-
-Eigen::Isometry3d World::robot_base_pose() const {
-  Eigen::Isometry3d base = Eigen::Isometry3d::Identity();
-  base.translation() = layout_.robot_base;
-  return base;
-}
 
 int World::add_object(const ObjectSpec& spec) {
   if (spec.name.empty()) throw Error("an object needs a name");
@@ -344,6 +325,20 @@ std::string World::robot_collision() const {
     PenetrationCallback self(0.002);
     w.contactPairTest(impl_->links[a].body.get(), impl_->links[b].body.get(), self);
     if (self.touching) return "collision:" + links[a].name + "-" + links[b].name;
+  }
+  return "";
+}
+
+std::string World::robot_object_contact(double tolerance_m) const {
+  auto& w = const_cast<btDiscreteDynamicsWorld&>(impl_->world);  // contactPairTest is not const
+  for (std::size_t i = 0; i < impl_->links.size(); ++i) {
+    if (!impl_->links[i].body) continue;
+    for (int id = 0; id < object_count(); ++id) {
+      if (id == held_ || !impl_->specs[id].collides) continue;
+      PenetrationCallback contact(tolerance_m);
+      w.contactPairTest(impl_->links[i].body.get(), impl_->objects[id].body.get(), contact);
+      if (contact.touching) return robot_.links()[i].name + "-" + impl_->specs[id].name;
+    }
   }
   return "";
 }

@@ -36,6 +36,12 @@ struct SceneLayout {
   Eigen::Vector3d table_centre{0.2, 0.0, 0.752};  // top surface centre
   Eigen::Vector2d table_extent_m{1.2, 1.4};
   Eigen::Vector3d robot_base{-0.3, 0.0, 0.752};
+
+  Eigen::Isometry3d robot_base_pose() const {  // facing +x, on the table
+    Eigen::Isometry3d base = Eigen::Isometry3d::Identity();
+    base.translation() = robot_base;
+    return base;
+  }
 };
 
 class World {
@@ -47,7 +53,7 @@ class World {
 
   const robot::RobotModel& robot() const { return robot_; }
   const SceneLayout& layout() const { return layout_; }
-  Eigen::Isometry3d robot_base_pose() const;
+  Eigen::Isometry3d robot_base_pose() const { return layout_.robot_base_pose(); }
 
   // --- objects --------------------------------------------------------------------------
   int add_object(const ObjectSpec& spec);  // returns the object's id
@@ -80,6 +86,10 @@ class World {
   // Robot contacts that make an action fail: a link touching the table or another link
   // (not its neighbours). Empty when none; otherwise a reason such as "collision:link3-table".
   std::string robot_collision() const;
+
+  // The first task object (colliding, not held) a robot link touches deeper than
+  // `tolerance_m`, as "<link>-<object>"; empty when none. For checking planned paths.
+  std::string robot_object_contact(double tolerance_m = 0.002) const;
 
   const btCollisionWorld& collision_world() const;
   static constexpr double kPhysicsStep = 1.0 / 240.0;

@@ -1,6 +1,8 @@
 #include "simulator/simulator.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "common/error.hpp"
 #include "common/random.hpp"
@@ -20,6 +22,23 @@ std::vector<double> row_major(const Matrix& m) {
 }
 
 }  // namespace
+
+SimulatorOptions options_from_camera_arguments(const std::string& cameras, const std::string& image_size) {
+  render::CameraIntrinsics intrinsics;
+  char x = 0;
+  std::istringstream size(image_size);
+  if (!(size >> intrinsics.width >> x >> intrinsics.height) || x != 'x' || !size.eof() || intrinsics.width < 8 ||
+      intrinsics.height < 8 || intrinsics.width > 4096 || intrinsics.height > 4096)
+    throw UsageError("--image-size: expected WxH between 8x8 and 4096x4096, got '" + image_size + "'");
+  SimulatorOptions options;
+  options.cameras.clear();
+  std::istringstream names(cameras);
+  for (std::string name; std::getline(names, name, ',');) {
+    options.cameras.push_back({name, intrinsics});
+  }
+  if (options.cameras.empty()) throw UsageError("--cameras: name at least one camera");
+  return options;
+}
 
 std::vector<std::string> camera_names() { return {"front", "wrist", "overhead"}; }
 
@@ -43,11 +62,10 @@ Eigen::Isometry3d camera_pose(const std::string& name, const sim::World& world) 
 
 Simulator::Simulator(const robot::RobotModel& robot, SimulatorOptions options)
     : robot_(robot), options_(std::move(options)) {
-  for (const auto& c : options_.cameras) {
-    bool known = false;
-    for (const auto& n : camera_names()) known |= n == c.name;
-    if (!known) camera_pose(c.name, sim::World(robot_));  // throws the listing error
-  }
+  const auto names = camera_names();
+  for (const auto& c : options_.cameras)
+    if (std::find(names.begin(), names.end(), c.name) == names.end())
+      throw Error("unknown camera '" + c.name + "' (known cameras: front, wrist, overhead)");
 }
 
 Simulator::~Simulator() = default;
@@ -87,6 +105,7 @@ stream::Record Simulator::observe(const std::string& failure) {
   obs.set_scalar<int32_t>("variation", variation_);
   obs.set_scalar<int64_t>("episode_seed", episode_seed_);
   obs.set_string("description", task_->description(variation_));
+  obs.set_scalar<uint8_t>("ignore_collisions", ignore_collisions_);
   if (!failure.empty()) obs.set_string("failure", failure);
   return obs;
 }
@@ -112,7 +131,7 @@ void Simulator::reset(const stream::Record& record,
   world_->settle(0.25);  // objects come to rest before the first image
   step_ = frame_ = 0;
   time_s_ = 0;
-  terminal_ = success_ = false;
+  terminal_ = success_ = ignore_collisions_ = false;
   velocity_.setZero();
   emit(observe());
 }
@@ -153,6 +172,7 @@ void Simulator::execute(const stream::Record& record,
   if (terminal_)
     throw StreamError(record.position, "trajectory after the episode ended: expected a reset record");
   step_ += 1;
+  ignore_collisions_ = record.has("ignore_collisions") && record.scalar<uint8_t>("ignore_collisions") != 0;
   std::string failure = check_trajectory(record);
   if (failure.empty()) {
     const auto times = record.array<double>("time_s");

@@ -33,6 +33,10 @@ struct SimulatorOptions {
   bool compress_images = false;       // zstd on rgb/depth/points (for files on disk)
 };
 
+// Options for the cameras named in `cameras` ("front,wrist") at resolution `image_size`
+// ("128x128"), as the tools' --cameras and --image-size give them. Throws UsageError.
+SimulatorOptions options_from_camera_arguments(const std::string& cameras, const std::string& image_size);
+
 // The camera poses of the scene layout (front: facing the robot across the table).
 Eigen::Isometry3d camera_pose(const std::string& name, const sim::World& world);
 std::vector<std::string> camera_names();
@@ -71,6 +75,7 @@ class Simulator {
   double time_s_ = 0;
   bool terminal_ = true;
   bool success_ = false;
+  bool ignore_collisions_ = false;  // of the trajectory that led to the current state
   robot::JointVector velocity_ = robot::JointVector::Zero();
 };
 

@@ -17,8 +17,15 @@ class ReachTarget : public Task {
 
   void build(sim::World& world, int variation, std::mt19937_64& rng) override {
     const double table = world.layout().table_height_m;
-    const auto positions = sample_separated(rng, 3, {kRegionMinX, kRegionMinY, table + 0.1},
-                                            {kRegionMaxX, kRegionMaxY, table + 0.35}, 0.2);
+    // Distractors never hover right above the target: the expert reaches it from above.
+    std::vector<Eigen::Vector3d> positions;
+    auto above_target = [&](const Eigen::Vector3d& p) {
+      return p.z() > positions[0].z() && (p - positions[0]).head<2>().norm() < 0.12;
+    };
+    do {
+      positions = sample_separated(rng, 3, {kRegionMinX, kRegionMinY, table + 0.1},
+                                   {kRegionMaxX, kRegionMaxY, table + 0.35}, 0.2);
+    } while (above_target(positions[1]) || above_target(positions[2]));
     const auto distractor_colours = pick_distinct(rng, 2, variation_count(), variation);
     for (int i = 0; i < 3; ++i) {
       sim::ObjectSpec sphere;

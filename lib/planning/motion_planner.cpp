@@ -1,0 +1,306 @@
+#include "planning/motion_planner.hpp"
+
+#include <ompl/base/spaces/RealVectorStateSpace.h>
+#include <ompl/base/samplers/UniformValidStateSampler.h>
+#include <ompl/geometric/SimpleSetup.h>
+#include <ompl/geometric/planners/rrt/RRTConnect.h>
+#include <ompl/util/Console.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "common/random.hpp"
+#include "planning/time_parametrization.hpp"
+
+namespace qte::planning {
+namespace ob = ompl::base;
+namespace og = ompl::geometric;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Uniform joint sampling with its own seed, so a plan depends only on its inputs and seed
+// (OMPL's default samplers draw seeds from a process-wide sequence).
+class SeededSampler : public ob::RealVectorStateSampler {
+ public:
+  SeededSampler(const ob::StateSpace* space, uint64_t seed) : ob::RealVectorStateSampler(space) {
+    rng_.setLocalSeed(static_cast<std::uint_fast32_t>(seed & 0xffffffffu));
+  }
+};
+
+robot::JointVector to_joints(const ob::State* state) {
+  const auto* v = state->as<ob::RealVectorStateSpace::StateType>();
+  robot::JointVector q;
+  for (int k = 0; k < robot::kArmJoints; ++k) q[k] = v->values[k];
+  return q;
+}
+
+// The camera names of an obs record: every "<name>.points" field with its extrinsics.
+std::vector<std::string> cameras_with_points(const stream::Record& obs) {
+  std::vector<std::string> names;
+  const std::string suffix = ".points";
+  for (const auto& f : obs.fields()) {
+    const std::string& n = f.name();
+    if (n.size() > suffix.size() && n.compare(n.size() - suffix.size(), suffix.size(), suffix) == 0)
+      names.push_back(n.substr(0, n.size() - suffix.size()));
+  }
+  return names;
+}
+
+}  // namespace
+
+StartState start_state_from(const stream::Record& obs) {
+  StartState start;
+  const auto q = obs.array<double>("joint_positions");
+  if (q.size() != robot::kArmJoints) obs.fail("joint_positions", "7 joint positions");
+  for (int k = 0; k < robot::kArmJoints; ++k) {
+    if (!std::isfinite(q[k])) obs.fail("joint_positions", "finite values");
+    start.joints[k] = q[k];
+  }
+  start.opening_m = obs.scalar<double>("gripper_opening_m");
+  start.holding = obs.scalar<uint8_t>("gripper_open") == 0 && start.opening_m > 0.002;
+  return start;
+}
+
+Goal goal_from(const stream::Record& action) {
+  const auto pose = action.array<double>("pose");
+  if (pose.size() != 7) action.fail("pose", "float64 [7]: x, y, z, qx, qy, qz, qw");
+  Goal goal;
+  const Eigen::Quaterniond rotation(pose[6], pose[3], pose[4], pose[5]);
+  goal.tcp_pose.translation() << pose[0], pose[1], pose[2];
+  goal.pose_valid = goal.tcp_pose.translation().allFinite() && rotation.coeffs().allFinite() &&
+                    std::abs(rotation.norm() - 1.0) <= 1e-3;
+  if (goal.pose_valid) goal.tcp_pose.linear() = rotation.normalized().toRotationMatrix();
+  goal.gripper_open = action.has("gripper_open") ? action.scalar<uint8_t>("gripper_open") != 0 : true;
+  goal.ignore_collisions = action.has("ignore_collisions") && action.scalar<uint8_t>("ignore_collisions") != 0;
+  return goal;
+}
+
+MotionPlanner::MotionPlanner(const robot::RobotModel& robot, const Eigen::Isometry3d& world_from_base,
+                             PlannerOptions options)
+    : robot_(robot), world_from_base_(world_from_base), options_(options), spheres_(robot) {
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+}
+
+OccupancyScene MotionPlanner::scene_from(const stream::Record& obs, const StartState& start, const Goal* goal) const {
+  const auto cameras = cameras_with_points(obs);
+  if (cameras.empty())
+    throw StreamError(obs.position, "'obs' record has no point cloud: plan-path needs <camera>.points "
+                                    "(sim-step without --no-points)");
+  std::vector<Sphere> robot_now;
+  spheres_.place(start.joints, start.opening_m, world_from_base_, robot_now);
+  std::vector<Sphere> free_regions;
+  if (start.holding) free_regions.push_back({world_from_base_ * robot_.tcp_pose(start.joints).translation(), 0.06, -1});
+  if (goal && goal->pose_valid) free_regions.push_back({goal->tcp_pose.translation(), options_.goal_free_radius_m, -1});
+  OccupancyScene scene(options_.scene);
+  for (const auto& camera : cameras) {
+    const auto points = obs.array<float>(camera + ".points");
+    const auto extrinsics = obs.array<double>(camera + ".extrinsics");
+    if (extrinsics.size() != 16) obs.fail(camera + ".extrinsics", "float64 [4, 4]");
+    if (points.shape.size() != 3 || points.shape[2] != 3) obs.fail(camera + ".points", "float32 [H, W, 3]");
+    const Eigen::Vector3d origin(extrinsics[3], extrinsics[7], extrinsics[11]);
+    scene.insert_camera(points.data, static_cast<std::size_t>(points.size() / 3), origin, robot_now, free_regions);
+  }
+  scene.build_distance_field();
+  return scene;
+}
+
+bool MotionPlanner::state_valid(const robot::JointVector& q, double opening_m, const OccupancyScene* scene) const {
+  thread_local std::vector<Sphere> placed;
+  spheres_.place(q, opening_m, world_from_base_, placed);
+  if (spheres_.self_collision(placed, 0.01)) return false;
+  // The camera sees only the table top; below it is solid, not free. The base link (0)
+  // stands on it.
+  for (const Sphere& s : placed)
+    if (s.link != 0 && s.centre.z() - s.radius_m < options_.table_height_m - 0.005) return false;
+  return !scene || !scene->collides(placed, options_.clearance_m);
+}
+
+bool MotionPlanner::motion_valid(const robot::JointVector& a, const robot::JointVector& b, double opening_m,
+                                 const OccupancyScene* scene) const {
+  const int steps = std::max(1, static_cast<int>(std::ceil((b - a).cwiseAbs().maxCoeff() / options_.check_step_rad)));
+  for (int i = 1; i <= steps; ++i)
+    if (!state_valid(a + (b - a) * (static_cast<double>(i) / steps), opening_m, scene)) return false;
+  return true;
+}
+
+std::vector<robot::JointVector> MotionPlanner::shortcut(std::vector<robot::JointVector> path, double opening_m,
+                                                        const OccupancyScene* scene) const {
+  // Greedy string pulling: from each kept waypoint jump to the farthest one reachable in a
+  // straight joint-space line. Deterministic, and usually leaves 2-4 waypoints.
+  std::vector<robot::JointVector> out = {path.front()};
+  std::size_t i = 0;
+  while (i + 1 < path.size()) {
+    std::size_t j = path.size() - 1;
+    while (j > i + 1 && !motion_valid(path[i], path[j], opening_m, scene)) --j;
+    out.push_back(path[j]);
+    i = j;
+  }
+  return out;
+}
+
+bool MotionPlanner::straight_line(const robot::JointVector& start, const Eigen::Isometry3d& goal_in_base,
+                                  double opening_m, std::vector<robot::JointVector>& path) const {
+  const Eigen::Isometry3d from = robot_.tcp_pose(start);
+  const double distance = (goal_in_base.translation() - from.translation()).norm();
+  const double angle = Eigen::AngleAxisd(goal_in_base.linear() * from.linear().transpose()).angle();
+  const int steps = std::max(1, static_cast<int>(std::ceil(std::max(distance / options_.straight_step_m, angle / 0.05))));
+  const Eigen::Quaterniond q0(from.linear()), q1(goal_in_base.linear());
+  path = {start};
+  robot::IkOptions ik;
+  ik.restarts = 0;  // follow the current branch: a jump would not be a straight line
+  for (int i = 1; i <= steps; ++i) {
+    const double t = static_cast<double>(i) / steps;
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.translation() = from.translation() + t * (goal_in_base.translation() - from.translation());
+    pose.linear() = q0.slerp(t, q1).toRotationMatrix();
+    const auto q = robot::solve_ik(robot_, pose, path.back(), ik);
+    if (!q || (*q - path.back()).cwiseAbs().maxCoeff() > 0.3) return false;
+    if (!state_valid(*q, opening_m, nullptr)) return false;
+    path.push_back(*q);
+  }
+  return true;
+}
+
+PlanResult MotionPlanner::plan(const StartState& start, const Goal& goal, const OccupancyScene& scene,
+                               uint64_t plan_index) const {
+  const auto t0 = Clock::now();
+  PlanResult result;
+  auto finish = [&](std::vector<robot::JointVector> path, const std::string& method) {
+    const robot::JointVector vmax = robot_.max_velocities() * options_.velocity_scale;
+    const robot::JointVector amax = robot::JointVector::Constant(options_.max_acceleration_rad_s2);
+    TimedPath timed = time_parametrize(path, vmax, amax, options_.sample_period_s);
+    result.time_s = std::move(timed.time_s);
+    result.joint_positions = std::move(timed.joint_positions);
+    result.method = method;
+    result.planning_time_s = std::chrono::duration<double>(Clock::now() - t0).count();
+    return result;
+  };
+  auto fail = [&](const std::string& reason) {
+    result.failure = reason;
+    result.planning_time_s = std::chrono::duration<double>(Clock::now() - t0).count();
+    return result;
+  };
+
+  if (!goal.pose_valid) return fail("invalid_pose");
+  const Eigen::Isometry3d goal_in_base = world_from_base_.inverse() * goal.tcp_pose;
+  // Farther than the TCP can ever be from the shoulder (0.93 m): no IK restarts needed.
+  if ((goal_in_base.translation() - Eigen::Vector3d(0, 0, 0.267)).norm() > 0.95) return fail("outside_workspace");
+
+  robot::IkOptions ik;
+  ik.seed = derive_seed(options_.seed, plan_index);
+  const double opening = start.opening_m;
+
+  if (goal.ignore_collisions) {
+    std::vector<robot::JointVector> path;
+    if (straight_line(start.joints, goal_in_base, opening, path)) return finish(path, "straight_line");
+    const auto q = robot::solve_ik(robot_, goal_in_base, start.joints, ik);
+    if (!q) return fail("ik_failed");
+    if (!motion_valid(start.joints, *q, opening, nullptr)) return fail("no_path");
+    return finish({start.joints, *q}, "direct");
+  }
+
+  if (!state_valid(start.joints, opening, &scene)) return fail("start_in_collision");
+  // Several IK solutions: the nearest collision-free one is the goal.
+  std::optional<robot::JointVector> goal_q;
+  bool any_solution = false;
+  for (int attempt = 0; attempt < 4 && !goal_q; ++attempt) {
+    ik.seed = derive_seed(ik.seed, attempt);
+    const auto q = robot::solve_ik(robot_, goal_in_base, start.joints, ik);
+    if (!q) break;
+    any_solution = true;
+    if (state_valid(*q, opening, &scene)) goal_q = q;
+  }
+  if (!any_solution) return fail("ik_failed");
+  if (!goal_q) return fail("goal_in_collision");
+  if (motion_valid(start.joints, *goal_q, opening, &scene)) return finish({start.joints, *goal_q}, "direct");
+
+  // RRT-Connect in joint space. Joints with 720-degree ranges are kept within half a turn
+  // of the start: more is never needed and it keeps collision checks dense.
+  auto space = std::make_shared<ob::RealVectorStateSpace>(robot::kArmJoints);
+  ob::RealVectorBounds bounds(robot::kArmJoints);
+  const robot::JointVector lo = robot_.lower_limits(), hi = robot_.upper_limits();
+  for (int k = 0; k < robot::kArmJoints; ++k) {
+    bounds.setLow(k, std::max(lo[k], std::min(start.joints[k], (*goal_q)[k]) - M_PI));
+    bounds.setHigh(k, std::min(hi[k], std::max(start.joints[k], (*goal_q)[k]) + M_PI));
+  }
+  space->setBounds(bounds);
+  const uint64_t sampler_seed = derive_seed(options_.seed ^ 0x5a5a5a5aull, plan_index);
+  space->setStateSamplerAllocator([sampler_seed](const ob::StateSpace* s) {
+    return std::make_shared<SeededSampler>(s, sampler_seed);
+  });
+  og::SimpleSetup setup(space);
+  setup.setStateValidityChecker([&](const ob::State* s) { return state_valid(to_joints(s), opening, &scene); });
+  setup.getSpaceInformation()->setStateValidityCheckingResolution(options_.check_step_rad / space->getMaximumExtent());
+  ob::ScopedState<> from(space), to(space);
+  for (int k = 0; k < robot::kArmJoints; ++k) {
+    from[k] = start.joints[k];
+    to[k] = (*goal_q)[k];
+  }
+  setup.setStartAndGoalStates(from, to);
+  auto planner = std::make_shared<og::RRTConnect>(setup.getSpaceInformation());
+  planner->setRange(0.5);
+  setup.setPlanner(planner);
+  setup.setup();
+  const ob::PlannerStatus status = setup.solve(ob::plannerOrTerminationCondition(
+      ob::timedPlannerTerminationCondition(options_.time_budget_s),
+      ob::exactSolnPlannerTerminationCondition(setup.getProblemDefinition())));
+  if (status != ob::PlannerStatus::EXACT_SOLUTION)
+    return fail(status == ob::PlannerStatus::TIMEOUT || status == ob::PlannerStatus::APPROXIMATE_SOLUTION ? "timeout" : "no_path");
+  std::vector<robot::JointVector> path;
+  for (const ob::State* s : setup.getSolutionPath().getStates()) path.push_back(to_joints(s));
+  return finish(shortcut(path, opening, &scene), "rrt_connect");
+}
+
+stream::Record action_record(const Goal& goal) {
+  stream::Record action("action");
+  const Eigen::Quaterniond q(goal.tcp_pose.linear());
+  const Eigen::Vector3d p = goal.tcp_pose.translation();
+  action.set<double>("pose", {7}, std::vector<double>{p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w()});
+  action.set_scalar<uint8_t>("gripper_open", goal.gripper_open);
+  action.set_scalar<uint8_t>("ignore_collisions", goal.ignore_collisions);
+  return action;
+}
+
+PlanPathFilter::PlanPathFilter(const robot::RobotModel& robot, const Eigen::Isometry3d& world_from_base,
+                               PlannerOptions options)
+    : planner_(robot, world_from_base, options) {}
+
+void PlanPathFilter::handle(const stream::Record& record,
+                            const std::function<void(const stream::Record&)>& emit) {
+  emit(record);
+  if (record.type() == "obs") {
+    obs_ = record;
+    scene_.reset();
+    return;
+  }
+  if (record.type() != "action") return;
+  if (!obs_)
+    throw StreamError(record.position, "action before any observation: plan-path needs the 'obs' record "
+                                       "(joint state and point cloud) ahead of each action");
+  const StartState start = start_state_from(*obs_);
+  const Goal goal = goal_from(record);
+  scene_ = std::make_unique<OccupancyScene>(planner_.scene_from(*obs_, start, &goal));
+  emit(trajectory_record(planner_.plan(start, goal, *scene_, plans_++), goal));
+}
+
+stream::Record trajectory_record(const PlanResult& plan, const Goal& goal) {
+  stream::Record t("trajectory");
+  if (!plan.failure.empty()) {
+    t.set_string("failure", plan.failure);
+  } else {
+    const int64_t n = static_cast<int64_t>(plan.time_s.size());
+    std::vector<double> joints;
+    for (const auto& q : plan.joint_positions) joints.insert(joints.end(), q.data(), q.data() + robot::kArmJoints);
+    t.set<double>("time_s", {n}, plan.time_s);
+    t.set<double>("joint_positions", {n, robot::kArmJoints}, joints);
+    t.set_scalar<uint8_t>("gripper_open", goal.gripper_open);
+    t.set_string("method", plan.method);
+  }
+  t.set_scalar<uint8_t>("ignore_collisions", goal.ignore_collisions);
+  t.set_scalar<double>("planning_time_s", plan.planning_time_s);
+  return t;
+}
+
+}  // namespace qte::planning

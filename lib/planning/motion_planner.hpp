@@ -1,0 +1,110 @@
+// From an observation and a next-best pose to a joint trajectory: IK for the goal, a
+// collision-free path on the sensed scene (OMPL RRT-Connect in joint space, after trying the
+// direct line), deterministic shortcutting, and a time parametrisation within the xArm 7's
+// velocity and acceleration limits. Moves flagged ignore-collisions follow a straight line
+// of the TCP instead (grasp approaches), as in RLBench and PerAct.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <optional>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "planning/occupancy_scene.hpp"
+#include "planning/robot_spheres.hpp"
+#include "robot/inverse_kinematics.hpp"
+#include "stream/record.hpp"
+
+namespace qte::planning {
+
+struct PlannerOptions {
+  double time_budget_s = 2.0;          // RRT-Connect stops here with "timeout"
+  double velocity_scale = 0.5;         // of the joints' 180 deg/s
+  double max_acceleration_rad_s2 = 8;  // per joint
+  double sample_period_s = 0.05;       // trajectory samples (sim-step's control period)
+  double clearance_m = 0.0;            // extra distance kept from occupied voxels
+  double check_step_rad = 0.02;        // collision checks along motions, largest joint step
+  double straight_step_m = 0.01;       // TCP step of straight-line moves
+  double goal_free_radius_m = 0.06;    // around the goal TCP, points are not obstacles
+  double table_height_m = 0.752;       // under the table top (unseen) is never free
+  uint64_t seed = 0;
+  SceneOptions scene;
+};
+
+struct Goal {
+  Eigen::Isometry3d tcp_pose = Eigen::Isometry3d::Identity();  // world frame
+  bool gripper_open = true;
+  bool ignore_collisions = false;
+  bool pose_valid = true;  // false for NaNs or a quaternion whose norm is not 1 (+-1e-3)
+};
+
+struct PlanResult {
+  std::string failure;  // empty on success: ik_failed, start_in_collision, goal_in_collision,
+                        // no_path, timeout, invalid_pose, outside_workspace
+  std::vector<double> time_s;
+  std::vector<robot::JointVector> joint_positions;
+  std::string method;   // direct, rrt_connect, straight_line
+  double planning_time_s = 0;
+};
+
+// The state the planner starts from, read from an obs record.
+struct StartState {
+  robot::JointVector joints = robot::JointVector::Zero();
+  double opening_m = 0;
+  bool holding = false;  // gripper closed on something: its points near the TCP are ignored
+};
+StartState start_state_from(const stream::Record& obs);
+Goal goal_from(const stream::Record& action);  // throws StreamError on missing/mistyped fields
+stream::Record action_record(const Goal& goal);  // pose, gripper_open, ignore_collisions
+
+class MotionPlanner {
+ public:
+  MotionPlanner(const robot::RobotModel& robot, const Eigen::Isometry3d& world_from_base,
+                PlannerOptions options = {});
+
+  // Builds the scene from every camera of `obs` (<camera>.points + <camera>.extrinsics),
+  // with the space around `goal` (if given) taken as free: the agent chose to go there.
+  OccupancyScene scene_from(const stream::Record& obs, const StartState& start, const Goal* goal = nullptr) const;
+
+  PlanResult plan(const StartState& start, const Goal& goal, const OccupancyScene& scene,
+                  uint64_t plan_index = 0) const;
+
+  // For tests and benchmarks: self-collision, and the scene when given (null: none).
+  bool state_valid(const robot::JointVector& q, double opening_m, const OccupancyScene* scene) const;
+
+ private:
+  bool motion_valid(const robot::JointVector& a, const robot::JointVector& b, double opening_m,
+                    const OccupancyScene* scene) const;
+  std::vector<robot::JointVector> shortcut(std::vector<robot::JointVector> path, double opening_m,
+                                           const OccupancyScene* scene) const;
+  bool straight_line(const robot::JointVector& start, const Eigen::Isometry3d& goal_in_base,
+                     double opening_m, std::vector<robot::JointVector>& path) const;
+
+  const robot::RobotModel& robot_;
+  Eigen::Isometry3d world_from_base_;
+  PlannerOptions options_;
+  RobotSpheres spheres_;
+};
+
+// plan-path as a library: observations pass through and are remembered; each action passes
+// through followed by its trajectory (or failure); other records pass through.
+class PlanPathFilter {
+ public:
+  PlanPathFilter(const robot::RobotModel& robot, const Eigen::Isometry3d& world_from_base, PlannerOptions options);
+  void handle(const stream::Record& record, const std::function<void(const stream::Record&)>& emit);
+  const OccupancyScene* last_scene() const { return scene_.get(); }
+  uint64_t plans() const { return plans_; }
+
+ private:
+  MotionPlanner planner_;
+  std::optional<stream::Record> obs_;
+  std::unique_ptr<OccupancyScene> scene_;  // of obs_ and the last action
+  uint64_t plans_ = 0;
+};
+
+// The trajectory record sim-step executes (or one carrying only `failure`).
+stream::Record trajectory_record(const PlanResult& plan, const Goal& goal);
+
+}  // namespace qte::planning
