@@ -299,7 +299,6 @@ stream::Record trajectory_record(const PlanResult& plan, const Goal& goal) {
     t.set_string("method", plan.method);
   }
   t.set_scalar<uint8_t>("ignore_collisions", goal.ignore_collisions);
-  t.set_scalar<double>("planning_time_s", plan.planning_time_s);
   return t;
 }
 

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# plan-path between the simulator's observations and its trajectories.
+set -uo pipefail
+tools=${QTE_TOOLS:?}
+export PATH="$tools:$PATH"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+
+stream-pack reset task=pick_and_lift seed:i64=2 > "$tmp/reset.rec"
+sim-step < "$tmp/reset.rec" > "$tmp/obs.rec" || fail "sim-step"
+# 40 cm above the table, gripper pointing down (180 deg about x: qx = 1).
+stream-pack action pose:f64=0.1,0.0,1.15,1,0,0,0 gripper_open:u8=1 > "$tmp/action.rec"
+cat "$tmp/obs.rec" "$tmp/action.rec" | plan-path --seed 3 --octomap "$tmp/scene.bt" > "$tmp/planned.rec" || fail "plan-path exit"
+[ "$(stream-dump --summary "$tmp/planned.rec" | cut -f1,2 | tr '\n' ' ')" = "$(printf 'action\t1 records obs\t1 records trajectory\t1 records ')" ] \
+  || fail "expected obs, action and trajectory to come out: $(stream-dump --summary "$tmp/planned.rec")"
+stream-dump --json --type trajectory "$tmp/planned.rec" | grep -q '"name":"joint_positions","dtype":"float64","shape":\[[0-9]*,7\]' \
+  || fail "no joint waypoints"
+head -c 40 "$tmp/scene.bt" | grep -q "Octomap OcTree binary file" || fail "--octomap did not write an OctoMap .bt"
+cat "$tmp/obs.rec" "$tmp/action.rec" | plan-path --seed 3 | cmp -s - "$tmp/planned.rec" || fail "same input and seed, different bytes"
+
+# The trajectory executes in the simulator: it starts where the arm is, stays within limits.
+{ cat "$tmp/reset.rec"; stream-cat --type trajectory "$tmp/planned.rec"; } | sim-step > "$tmp/after.rec" || fail "sim-step on the plan"
+stream-dump --json --type obs "$tmp/after.rec" | tail -n 1 > "$tmp/last.json"
+grep -q '"name":"failure"' "$tmp/last.json" && fail "the planned trajectory failed in the simulator: $(grep -o '"name":"failure"[^}]*' "$tmp/last.json")"
+grep -q '"name":"step","dtype":"int32","shape":\[\],"values":\[1\]' "$tmp/last.json" || fail "no observation after the move"
+
+# Invalid poses come back as failures, not crashes.
+stream-pack action pose:f64=0.1,nan,1,1,0,0,0 > "$tmp/nan.rec"
+stream-pack action pose:f64=0.1,0,1,0.5,0,0,0 > "$tmp/nonunit.rec"
+stream-pack action pose:f64=3,0,1,1,0,0,0 > "$tmp/far.rec"
+for case in nan:invalid_pose nonunit:invalid_pose far:outside_workspace; do
+  name=${case%%:*} reason=${case##*:}
+  cat "$tmp/obs.rec" "$tmp/$name.rec" | plan-path | stream-dump --json --type trajectory > "$tmp/$name.json" || fail "$name: exit $?"
+  grep -q "\"value\":\"$reason\"" "$tmp/$name.json" || fail "$name: expected failure $reason: $(cat "$tmp/$name.json")"
+done
+
+# An action with no observation before it is a stream error naming the record.
+err=$(plan-path < "$tmp/action.rec" 2>&1 >/dev/null); rc=$?
+[ $rc = 1 ] || fail "action before obs: exit $rc"
+grep -q "<stdin>: record 0 at byte 0: action before any observation" <<<"$err" || fail "$err"
+echo "plan-path ok"
