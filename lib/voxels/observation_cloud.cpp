@@ -1,0 +1,73 @@
+#include "voxels/observation_cloud.hpp"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <limits>
+
+namespace qte::voxels {
+
+void points_from_depth(const float* depth_m, int width, int height, const double* k, const double* e,
+                       float* xyz_out) {
+  const double fx = k[0], cx = k[2], fy = k[4], cy = k[5];
+  const Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> pose(e);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int v = 0; v < height; ++v)
+    for (int u = 0; u < width; ++u) {
+      const int i = v * width + u;
+      const double z = depth_m[i];
+      float* out = xyz_out + 3 * i;
+      if (!(z > 0)) {
+        out[0] = out[1] = out[2] = nan;
+        continue;
+      }
+      const Eigen::Vector4d camera((u - cx) / fx * z, (v - cy) / fy * z, z, 1.0);
+      const Eigen::Vector4d world = pose * camera;
+      out[0] = static_cast<float>(world.x());
+      out[1] = static_cast<float>(world.y());
+      out[2] = static_cast<float>(world.z());
+    }
+}
+
+ObservationCloud observation_cloud(const stream::Record& obs) {
+  ObservationCloud cloud;
+  const std::string suffix = ".rgb";
+  for (const auto& field : obs.fields()) {
+    const std::string& name = field.name();
+    if (name.size() <= suffix.size() || name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) continue;
+    const std::string camera = name.substr(0, name.size() - suffix.size());
+    const auto rgb = obs.array<uint8_t>(name);
+    if (rgb.shape.size() != 3 || rgb.shape[2] != 3) obs.fail(name, "uint8 [H, W, 3]");
+    const int h = static_cast<int>(rgb.shape[0]), w = static_cast<int>(rgb.shape[1]);
+    const std::size_t n = static_cast<std::size_t>(h) * w, at = cloud.rgb.size() / 3;
+    cloud.rgb.insert(cloud.rgb.end(), rgb.begin(), rgb.end());
+    cloud.xyz.resize(3 * (at + n));
+    float* out = cloud.xyz.data() + 3 * at;
+    if (obs.has(camera + ".points")) {
+      const auto points = obs.array<float>(camera + ".points");
+      if (points.shape != stream::Shape{h, w, 3}) obs.fail(camera + ".points", "float32 [H, W, 3] like " + name);
+      std::copy(points.begin(), points.end(), out);
+      continue;
+    }
+    std::vector<float> depth(n);
+    if (obs.has(camera + ".depth_mm")) {
+      const auto mm = obs.array<uint16_t>(camera + ".depth_mm");
+      if (mm.shape != stream::Shape{h, w}) obs.fail(camera + ".depth_mm", "uint16 [H, W] like " + name);
+      for (std::size_t i = 0; i < n; ++i) depth[i] = mm[i] * 0.001f;
+    } else {
+      const auto d = obs.array<float>(camera + ".depth");
+      if (d.shape != stream::Shape{h, w}) obs.fail(camera + ".depth", "float32 [H, W] like " + name);
+      std::copy(d.begin(), d.end(), depth.begin());
+    }
+    const auto k = obs.array<double>(camera + ".intrinsics");
+    const auto e = obs.array<double>(camera + ".extrinsics");
+    if (k.size() != 9) obs.fail(camera + ".intrinsics", "float64 [3, 3]");
+    if (e.size() != 16) obs.fail(camera + ".extrinsics", "float64 [4, 4]");
+    points_from_depth(depth.data(), w, h, k.data, e.data, out);
+  }
+  if (cloud.rgb.empty())
+    throw StreamError(obs.position, "'" + obs.type() + "' record has no camera image (<camera>.rgb with "
+                                    "<camera>.points or <camera>.depth): nothing to voxelize");
+  return cloud;
+}
+
+}  // namespace qte::voxels

@@ -1,0 +1,28 @@
+// The coloured point cloud of an observation record, from every camera: the stored world
+// points (<camera>.points), or points rebuilt from depth and the camera's intrinsics and
+// extrinsics when only depth is stored (<camera>.depth in metres, or <camera>.depth_mm as
+// uint16 millimetres, the compact form of the replay).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "stream/record.hpp"
+#include "voxels/voxel_grid.hpp"
+
+namespace qte::voxels {
+
+struct ObservationCloud {
+  std::vector<float> xyz;    // count * 3, world frame; NaN where a pixel has no return
+  std::vector<uint8_t> rgb;  // count * 3
+  PointCloud view() const { return {xyz.data(), rgb.data(), rgb.size() / 3}; }
+};
+
+// Throws StreamError naming the record when it holds no camera with rgb and points or depth.
+ObservationCloud observation_cloud(const stream::Record& obs);
+
+// World points of a depth image (metres along the optical axis, 0 = none -> NaN).
+void points_from_depth(const float* depth_m, int width, int height, const double* intrinsics_3x3,
+                       const double* extrinsics_4x4, float* xyz_out);
+
+}  // namespace qte::voxels

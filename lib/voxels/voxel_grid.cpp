@@ -1,0 +1,139 @@
+#include "voxels/voxel_grid.hpp"
+
+#include <cmath>
+#include <cstring>
+
+#include "common/error.hpp"
+
+namespace qte::voxels {
+
+Eigen::Vector3i GridBounds::index_of(const Eigen::Vector3d& point) const {
+  const Eigen::Vector3d scaled = (point - min_corner) / voxel_size_m();
+  return Eigen::Vector3i(static_cast<int>(std::floor(scaled.x())), static_cast<int>(std::floor(scaled.y())),
+                         static_cast<int>(std::floor(scaled.z())));
+}
+
+Eigen::Vector3d GridBounds::centre_of(const Eigen::Vector3i& index) const {
+  return min_corner + (index.cast<double>() + Eigen::Vector3d::Constant(0.5)) * voxel_size_m();
+}
+
+bool GridBounds::contains(const Eigen::Vector3i& index) const {
+  return (index.array() >= 0).all() && (index.array() < voxels).all();
+}
+
+GridBounds GridBounds::around(const Eigen::Vector3d& centre, double half_extent_m, int voxels) {
+  GridBounds b;
+  b.min_corner = centre - Eigen::Vector3d::Constant(half_extent_m);
+  b.size_m = 2 * half_extent_m;
+  b.voxels = voxels;
+  return b;
+}
+
+GridBounds CoarseToFine::bounds_at(int depth, const Eigen::Vector3d& previous_centre) const {
+  if (depth == 0) return scene;
+  return GridBounds::around(previous_centre, offset_m, scene.voxels);
+}
+
+std::vector<Eigen::Vector3i> CoarseToFine::indices_of(const Eigen::Vector3d& target,
+                                                      const std::vector<Eigen::Vector3d>& centre_shifts) const {
+  std::vector<Eigen::Vector3i> indices;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (int d = 0; d < depths; ++d) {
+    if (d > 0 && d < static_cast<int>(centre_shifts.size())) centre += centre_shifts[d];
+    const GridBounds bounds = bounds_at(d, centre);
+    Eigen::Vector3i index = bounds.index_of(target);
+    index = index.cwiseMax(0).cwiseMin(bounds.voxels - 1);  // on the far face: the last voxel
+    indices.push_back(index);
+    centre = bounds.centre_of(index);
+  }
+  return indices;
+}
+
+namespace {
+
+// Sums per voxel: x, y, z, r, g, b, count.
+constexpr int kSums = 7;
+
+// One pass over the points, each tested against every grid (the K branches of a tree
+// expansion share one read of the cloud).
+void accumulate(const PointCloud& cloud, const std::vector<GridBounds>& grids, float* sums) {
+  const int v = grids[0].voxels;
+  const std::size_t grid_sums = static_cast<std::size_t>(v) * v * v * kSums;
+  struct Frame {
+    float lo[3];
+    float inv;
+  };
+  std::vector<Frame> frames;
+  for (const auto& b : grids)
+    frames.push_back({{static_cast<float>(b.min_corner.x()), static_cast<float>(b.min_corner.y()),
+                       static_cast<float>(b.min_corner.z())},
+                      static_cast<float>(1.0 / b.voxel_size_m())});
+  const float vf = static_cast<float>(v);
+  for (std::size_t i = 0; i < cloud.count; ++i) {
+    const float* p = cloud.xyz + 3 * i;
+    const uint8_t* c = cloud.rgb + 3 * i;
+    for (std::size_t g = 0; g < frames.size(); ++g) {
+      const Frame& f = frames[g];
+      const float fx = (p[0] - f.lo[0]) * f.inv, fy = (p[1] - f.lo[1]) * f.inv, fz = (p[2] - f.lo[2]) * f.inv;
+      // NaN fails every comparison, so it is skipped with the out-of-bounds points.
+      if (!(fx >= 0 && fy >= 0 && fz >= 0 && fx < vf && fy < vf && fz < vf)) continue;
+      const int flat = (static_cast<int>(fx) * v + static_cast<int>(fy)) * v + static_cast<int>(fz);
+      float* s = sums + g * grid_sums + kSums * flat;
+      s[0] += p[0];
+      s[1] += p[1];
+      s[2] += p[2];
+      s[3] += c[0];
+      s[4] += c[1];
+      s[5] += c[2];
+      s[6] += 1;
+    }
+  }
+}
+
+void finish(const float* sums, int v, float* out) {
+  const float inv_v = 1.0f / v;
+  for (int x = 0, flat = 0; x < v; ++x)
+    for (int y = 0; y < v; ++y)
+      for (int z = 0; z < v; ++z, ++flat) {
+        const float* s = sums + kSums * flat;
+        float* o = out + kChannels * flat;
+        const float n = s[6];
+        if (n > 0) {
+          const float inv_n = 1.0f / n;
+          o[0] = s[0] * inv_n;
+          o[1] = s[1] * inv_n;
+          o[2] = s[2] * inv_n;
+          // RGB bytes to [-1, 1]: c / 255 * 2 - 1.
+          o[3] = s[3] * inv_n * (2.0f / 255.0f) - 1.0f;
+          o[4] = s[4] * inv_n * (2.0f / 255.0f) - 1.0f;
+          o[5] = s[5] * inv_n * (2.0f / 255.0f) - 1.0f;
+          o[9] = 1.0f;
+        } else {
+          o[0] = o[1] = o[2] = o[3] = o[4] = o[5] = o[9] = 0.0f;
+        }
+        o[6] = x * inv_v;
+        o[7] = y * inv_v;
+        o[8] = z * inv_v;
+      }
+}
+
+}  // namespace
+
+void voxelize(const PointCloud& cloud, const GridBounds& bounds, float* out) {
+  voxelize_many(cloud, {bounds}, out);
+}
+
+void voxelize_many(const PointCloud& cloud, const std::vector<GridBounds>& grids, float* out) {
+  if (grids.empty()) return;
+  const int v = grids[0].voxels;
+  for (const auto& g : grids)
+    if (g.voxels != v || v < 1 || v > 512) throw Error("voxelize_many: every grid needs the same 1-512 voxels per side");
+  const std::size_t cells = static_cast<std::size_t>(v) * v * v;
+  thread_local std::vector<float> sums;
+  sums.assign(cells * kSums * grids.size(), 0.0f);
+  accumulate(cloud, grids, sums.data());
+  for (std::size_t g = 0; g < grids.size(); ++g)
+    finish(sums.data() + g * cells * kSums, v, out + g * cells * kChannels);
+}
+
+}  // namespace qte::voxels

@@ -1,0 +1,120 @@
+// voxelize: observations to coarse-to-fine voxel grids (C2F-ARM's 10 channels).
+#include <sys/stat.h>
+
+#include <cstdio>
+#include <sstream>
+
+#include "cli/command.hpp"
+#include "stream/reader.hpp"
+#include "stream/writer.hpp"
+#include "voxels/observation_cloud.hpp"
+#include "voxels/voxel_image.hpp"
+
+using namespace qte;
+
+static cli::Usage usage() {
+  cli::Usage u;
+  u.name = "voxelize";
+  u.summary = "turn observations into C2F-ARM voxel grids";
+  u.description = {
+      "Reads a record stream and passes every record through; after each 'obs' record it writes "
+      "a 'voxels' record holding the depth-0 grid over the scene bounds and, for every --centre, "
+      "a deeper grid of centre +- --offset (the crops coarse-to-fine attention zooms into). The "
+      "point cloud is every camera's <camera>.points with <camera>.rgb (or points rebuilt from "
+      "<camera>.depth / depth_mm and the camera's intrinsics and extrinsics); points outside a "
+      "grid, and pixels without a return, are ignored.",
+      "Each voxel has 10 channels, channels last: the mean x, y, z of its points (world frame, "
+      "metres), their mean r, g, b scaled to [-1, 1], the voxel's index divided by the grid "
+      "size for x, y, z, and occupancy (1 when it holds a point); empty voxels are zero but "
+      "for their index channels. A voxel's coordinate is its centre: min + (index + 0.5) * size.",
+      "With --png DIR a picture of every grid is saved (occupied voxels as cubes in their "
+      "colour): the way to see what the attention sees.",
+  };
+  u.arguments = {{"FILE", "input records; '-' or absent is standard input", true, false}};
+  u.options = {
+      {"voxels", "V", "voxels per side of every grid", "16"},
+      {"bounds", "X,Y,Z,S", "scene bounds: minimum corner and edge length in metres", "-0.3,-0.5,0.6,1.0"},
+      {"centre", "X,Y,Z", "also voxelize centre +- offset at depth 1 (repeat for several: one batched pass)", "", true},
+      {"offset", "M", "half edge of the deeper grids, metres", "0.15"},
+      {"png", "DIR", "save a picture of every grid as DIR/<record>.depth<d>[.<k>].png", ""},
+      {"output", "FILE", "where to write; '-' is standard output", "-"},
+  };
+  u.examples = {
+      {"sim-step --task reach_target < /dev/null | voxelize --png grids/ | stream-dump --type voxels",
+       "voxelize the first observation and look at it"},
+      {"voxelize --centre 0.2,0,0.8 --centre 0.1,0.2,0.8 < obs.rec > with_voxels.rec",
+       "two deeper crops of each observation in one pass over its points"},
+  };
+  u.see_also = {"qte-select(1)", "keyframe(1)", "qte-stream(5)"};
+  return u;
+}
+
+static std::vector<double> numbers(const std::string& option, const std::string& text, std::size_t count) {
+  std::vector<double> v;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, ',');) {
+    try {
+      std::size_t used = 0;
+      v.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw UsageError("--" + option + ": '" + item + "' is not a number");
+    }
+  }
+  if (v.size() != count) throw UsageError("--" + option + ": expected " + std::to_string(count) + " comma-separated numbers");
+  return v;
+}
+
+static void run(const cli::Arguments& args) {
+  voxels::GridBounds scene;
+  scene.voxels = static_cast<int>(args.integer("voxels"));
+  if (scene.voxels < 2 || scene.voxels > 256) throw UsageError("--voxels must be 2-256");
+  const auto b = numbers("bounds", args.text("bounds"), 4);
+  scene.min_corner = Eigen::Vector3d(b[0], b[1], b[2]);
+  scene.size_m = b[3];
+  if (!(scene.size_m > 0)) throw UsageError("--bounds: the edge length must be positive");
+  const double offset = args.real("offset");
+  std::vector<voxels::GridBounds> crops;
+  for (const auto& c : args.all("centre")) {
+    const auto p = numbers("centre", c, 3);
+    crops.push_back(voxels::GridBounds::around({p[0], p[1], p[2]}, offset, scene.voxels));
+  }
+  const std::string png_dir = args.text("png");
+  if (!png_dir.empty() && ::mkdir(png_dir.c_str(), 0755) != 0 && errno != EEXIST)
+    throw_system_error("cannot create directory " + png_dir);
+
+  const int64_t v = scene.voxels;
+  const std::size_t grid_floats = static_cast<std::size_t>(v * v * v) * voxels::kChannels;
+  stream::RecordReader reader(args.positional().empty() ? "-" : args.positional()[0]);
+  stream::RecordWriter writer(args.text("output"));
+  std::vector<float> grid(grid_floats), crop_grids(grid_floats * crops.size());
+  while (auto record = reader.next()) {
+    writer.write(*record);
+    if (record->type() != "obs") continue;
+    const voxels::ObservationCloud cloud = voxels::observation_cloud(*record);
+    voxels::voxelize(cloud.view(), scene, grid.data());
+    stream::Record out("voxels");
+    out.set<float>("depth0.grid", {v, v, v, voxels::kChannels}, grid.data());
+    out.set<double>("depth0.bounds", {4}, std::vector<double>{b[0], b[1], b[2], b[3]});
+    if (!crops.empty()) {
+      voxels::voxelize_many(cloud.view(), crops, crop_grids.data());
+      const int64_t k = static_cast<int64_t>(crops.size());
+      std::vector<double> bounds;
+      for (const auto& c : crops) bounds.insert(bounds.end(), {c.min_corner.x(), c.min_corner.y(), c.min_corner.z(), c.size_m});
+      out.set<float>("depth1.grid", {k, v, v, v, voxels::kChannels}, crop_grids.data());
+      out.set<double>("depth1.bounds", {k, 4}, bounds);
+    }
+    if (!png_dir.empty()) {
+      char index[16];
+      std::snprintf(index, sizeof index, "%06llu", static_cast<unsigned long long>(record->position.record_index));
+      voxels::save_voxel_png(png_dir + "/" + index + ".depth0.png", grid.data(), scene.voxels);
+      for (std::size_t c = 0; c < crops.size(); ++c)
+        voxels::save_voxel_png(png_dir + "/" + index + ".depth1." + std::to_string(c) + ".png",
+                               crop_grids.data() + c * grid_floats, scene.voxels);
+    }
+    writer.write(out);
+  }
+  writer.close();
+}
+
+int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }
