@@ -1,0 +1,202 @@
+#include "keyframes/transitions.hpp"
+
+#include <cmath>
+#include <set>
+
+#include "common/random.hpp"
+#include "keyframes/keyframes.hpp"
+
+namespace qte::keyframes {
+namespace {
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() > suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// FNV-1a: a stable 64-bit key for an episode from what identifies it.
+uint64_t fnv1a(const void* data, std::size_t n, uint64_t h = 1469598103934665603ull) {
+  const auto* p = static_cast<const uint8_t*>(data);
+  for (std::size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
+  return h;
+}
+
+Eigen::Isometry3d gripper_pose(const stream::Record& obs) {
+  const auto p = obs.array<double>("gripper_pose");
+  if (p.size() != 7) obs.fail("gripper_pose", "float64 [7]");
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() << p[0], p[1], p[2];
+  pose.linear() = Eigen::Quaterniond(p[6], p[3], p[4], p[5]).normalized().toRotationMatrix();
+  return pose;
+}
+
+}  // namespace
+
+std::string ConversionCounts::summary() const {
+  std::string s = std::to_string(converted) + "/" + std::to_string(episodes) + " episodes converted, " +
+                  std::to_string(frames) + " frames, " + std::to_string(transitions) + " transitions";
+  const std::pair<const char*, int> skips[] = {{"empty", skipped_empty},
+                                               {"unsuccessful", skipped_failed},
+                                               {"without keyframes", skipped_no_keyframes},
+                                               {"with frames out of order", skipped_out_of_order},
+                                               {"with a keyframe outside the scene bounds", skipped_outside_bounds}};
+  for (const auto& [what, n] : skips)
+    if (n > 0) s += "; skipped " + std::to_string(n) + " " + what;
+  return s;
+}
+
+stream::Record frame_record(const stream::Record& obs, int64_t episode_key) {
+  stream::Record frame("frame");
+  frame.set_scalar<int64_t>("episode_key", episode_key);
+  frame.set_scalar<int32_t>("frame", obs.scalar<int32_t>("frame"));
+  for (const auto& field : obs.fields()) {
+    const std::string& name = field.name();
+    if (ends_with(name, ".rgb")) {
+      frame.set_raw(name, field.dtype(), field.shape(), field.bytes(), /*compress=*/true);
+    } else if (ends_with(name, ".depth")) {
+      // Millimetres in 16 bits: 0.5 mm rounding, far below a 1.9 cm voxel, half the bytes.
+      const auto depth = obs.array<float>(name);
+      std::vector<uint16_t> mm(static_cast<std::size_t>(depth.size()));
+      for (std::size_t i = 0; i < mm.size(); ++i)
+        mm[i] = static_cast<uint16_t>(std::clamp(std::lround(depth[static_cast<int64_t>(i)] * 1000.0), 0L, 65535L));
+      frame.set<uint16_t>(name + "_mm", depth.shape, mm, /*compress=*/true);
+    } else if (ends_with(name, ".intrinsics") || ends_with(name, ".extrinsics")) {
+      frame.add(field);
+    }
+  }
+  for (const char* name : {"joint_positions", "gripper_pose", "gripper_open", "gripper_opening_m", "task", "variation"})
+    if (obs.has(name)) frame.add(obs.field(name));
+  return frame;
+}
+
+EpisodeConverter::EpisodeConverter(TransitionOptions options, std::function<void(const stream::Record&)> emit)
+    : options_(std::move(options)), emit_(std::move(emit)), rng_(options_.seed) {}
+
+void EpisodeConverter::handle(const stream::Record& record) {
+  if (record.type() == "episode") {
+    convert(episode_, &record);
+    episode_.clear();
+  } else if (record.type() == "obs") {
+    if (!episode_.empty() && record.scalar<int32_t>("frame") == 0) {
+      convert(episode_, nullptr);
+      episode_.clear();
+    }
+    episode_.push_back(record);
+  }
+}
+
+void EpisodeConverter::finish() {
+  if (!episode_.empty()) convert(episode_, nullptr);
+  episode_.clear();
+}
+
+void EpisodeConverter::convert(std::vector<stream::Record>& episode, const stream::Record* summary) {
+  counts_.episodes += 1;
+  if (episode.size() < 2) {
+    counts_.skipped_empty += 1;
+    return;
+  }
+  for (std::size_t i = 1; i < episode.size(); ++i)
+    if (episode[i].scalar<int32_t>("frame") != episode[i - 1].scalar<int32_t>("frame") + 1) {
+      counts_.skipped_out_of_order += 1;
+      return;
+    }
+  const bool success = summary ? summary->scalar<uint8_t>("success") != 0 : episode.back().scalar<uint8_t>("success") != 0;
+  if (!success && !options_.keep_failed) {
+    counts_.skipped_failed += 1;
+    return;
+  }
+  std::vector<FrameState> states;
+  for (const auto& obs : episode) {
+    FrameState s;
+    s.gripper_open = obs.scalar<uint8_t>("gripper_open") != 0;
+    const auto v = obs.array<double>("joint_velocities");
+    if (v.size() != 7) obs.fail("joint_velocities", "float64 [7]");
+    std::copy(v.begin(), v.end(), s.joint_velocities.begin());
+    states.push_back(s);
+  }
+  const std::vector<int> keyframes = discover_keyframes(states, options_.stopping_delta);
+  if (keyframes.empty()) {
+    counts_.skipped_no_keyframes += 1;
+    return;
+  }
+  const voxels::GridBounds& scene = options_.hierarchy.scene;
+  for (int k : keyframes)
+    if (!scene.contains(scene.index_of(gripper_pose(episode[k]).translation()))) {
+      counts_.skipped_outside_bounds += 1;
+      return;
+    }
+
+  // The episode's key: what identifies it, hashed (frames refer to it across appended files).
+  const std::string task = episode[0].has("task") ? episode[0].string("task") : "";
+  uint64_t key = fnv1a(task.data(), task.size());
+  const int64_t seed = episode[0].has("episode_seed") ? episode[0].scalar<int64_t>("episode_seed") : 0;
+  const auto last_pose = episode.back().array<double>("gripper_pose");
+  key = fnv1a(&seed, sizeof seed, key);
+  key = fnv1a(last_pose.data, 7 * sizeof(double), key);
+  const int64_t episode_key = static_cast<int64_t>(derive_seed(key, options_.seed));
+
+  // Chains: from frame 0 and every n-th frame before the last keyframe, through the
+  // keyframes after it.
+  std::vector<int> starts = {0};
+  if (options_.augmentation_every_n > 0)
+    for (int i = options_.augmentation_every_n; i < keyframes.back(); i += options_.augmentation_every_n) starts.push_back(i);
+  std::set<int> stored;
+  auto store = [&](int i) {
+    if (stored.insert(i).second) {
+      emit_(frame_record(episode[i], episode_key));
+      counts_.frames += 1;
+    }
+  };
+  const voxels::CoarseToFine& h = options_.hierarchy;
+  std::uniform_real_distribution<double> shift(-options_.crop_shift_fraction * h.offset_m,
+                                               options_.crop_shift_fraction * h.offset_m);
+  for (int start : starts) {
+    int previous = start, step = 0;
+    for (int k : keyframes) {
+      if (k <= start) continue;
+      const stream::Record& target = episode[k];
+      const Eigen::Isometry3d pose = gripper_pose(target);
+      std::vector<Eigen::Vector3d> shifts(h.depths, Eigen::Vector3d::Zero());
+      if (options_.crop_augmentation)
+        for (int d = 1; d < h.depths; ++d) shifts[d] = Eigen::Vector3d(shift(rng_), shift(rng_), shift(rng_));
+      const auto indices = h.indices_of(pose.translation(), shifts);
+
+      stream::Record t("transition");
+      t.set_scalar<int64_t>("episode_key", episode_key);
+      t.set_scalar<int32_t>("frame", episode[previous].scalar<int32_t>("frame"));
+      t.set_scalar<int32_t>("next_frame", target.scalar<int32_t>("frame"));
+      t.set_scalar<int32_t>("step", step);
+      Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+      for (int d = 0; d < h.depths; ++d) {
+        if (d > 0) centre += shifts[d];
+        const voxels::GridBounds b = h.bounds_at(d, centre);
+        const std::string prefix = "depth" + std::to_string(d);
+        t.set<int32_t>(prefix + ".index", {3}, indices[d].data());
+        t.set<double>(prefix + ".bounds", {4},
+                      std::vector<double>{b.min_corner.x(), b.min_corner.y(), b.min_corner.z(), b.size_m});
+        centre = b.centre_of(indices[d]);
+      }
+      const Eigen::Vector3i bins = rotation_bins(pose.linear());
+      t.set<int32_t>("rotation_bins", {3}, bins.data());
+      t.set_scalar<uint8_t>("gripper_open", target.scalar<uint8_t>("gripper_open"));
+      t.set_scalar<uint8_t>("ignore_collisions",
+                            target.has("ignore_collisions") ? target.scalar<uint8_t>("ignore_collisions") : 0);
+      const Eigen::Quaterniond q(pose.linear());
+      t.set<double>("target_pose", {7}, std::vector<double>{pose.translation().x(), pose.translation().y(),
+                                                            pose.translation().z(), q.x(), q.y(), q.z(), q.w()});
+      const bool last = k == keyframes.back();
+      t.set_scalar<float>("reward", last && success ? 100.0f : 0.0f);
+      t.set_scalar<uint8_t>("terminal", last);
+      t.set_scalar<uint8_t>("demo", options_.demo);
+      store(previous);
+      store(k);
+      emit_(t);
+      counts_.transitions += 1;
+      previous = k;
+      ++step;
+    }
+  }
+  counts_.converted += 1;
+}
+
+}  // namespace qte::keyframes

@@ -1,0 +1,63 @@
+// Demonstrations to replay transitions, as C2F-ARM builds them: keyframes of each episode,
+// chains started at every n-th frame (demo augmentation), and per transition the action of
+// the next keyframe: coarse-to-fine voxel indices (with crop augmentation), rotation bins,
+// gripper state. Observations are stored once, compactly, as 'frame' records; transitions
+// refer to them.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "stream/record.hpp"
+#include "voxels/voxel_grid.hpp"
+
+namespace qte::keyframes {
+
+struct TransitionOptions {
+  voxels::CoarseToFine hierarchy;
+  int augmentation_every_n = 10;  // 0: chains only from the first frame
+  bool crop_augmentation = true;
+  double crop_shift_fraction = 0.75;  // of the offset, per axis, uniform
+  double stopping_delta = 0.1;
+  bool keep_failed = false;  // transitions from unsuccessful episodes too (reward 0)
+  bool demo = true;          // mark transitions as demonstrations
+  uint64_t seed = 0;
+};
+
+// What happened to the episodes given to an EpisodeConverter, for the report on stderr.
+struct ConversionCounts {
+  int episodes = 0, converted = 0;
+  int skipped_empty = 0, skipped_failed = 0, skipped_no_keyframes = 0, skipped_out_of_order = 0,
+      skipped_outside_bounds = 0;
+  int64_t frames = 0, transitions = 0;
+  std::string summary() const;
+};
+
+class EpisodeConverter {
+ public:
+  EpisodeConverter(TransitionOptions options, std::function<void(const stream::Record&)> emit);
+
+  // Feed a demonstration stream record by record: obs records gather into an episode, which
+  // ends at an 'episode' record or at an obs with frame 0; finish() converts the last one.
+  void handle(const stream::Record& record);
+  void finish();
+  const ConversionCounts& counts() const { return counts_; }
+
+ private:
+  void convert(std::vector<stream::Record>& episode, const stream::Record* summary);
+
+  TransitionOptions options_;
+  std::function<void(const stream::Record&)> emit_;
+  std::vector<stream::Record> episode_;
+  ConversionCounts counts_;
+  std::mt19937_64 rng_;
+};
+
+// The compact 'frame' record of an observation: images (rgb; depth as uint16 millimetres,
+// zstd-compressed), camera matrices and proprioception, keyed by (episode_key, frame).
+stream::Record frame_record(const stream::Record& obs, int64_t episode_key);
+
+}  // namespace qte::keyframes

@@ -1,0 +1,188 @@
+// Keyframe discovery case by case, on expert demonstrations, rotation bins, and the
+// transitions' crop augmentation.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <set>
+
+#include "demos/demo_recorder.hpp"
+#include "keyframes/keyframes.hpp"
+#include "keyframes/transitions.hpp"
+
+using namespace qte;
+using namespace qte::keyframes;
+
+namespace {
+
+// n frames moving (velocity 0.5) with the gripper open.
+std::vector<FrameState> moving(int n) {
+  std::vector<FrameState> frames(n);
+  for (auto& f : frames) f.joint_velocities.fill(0.5);
+  return frames;
+}
+
+void stop_at(std::vector<FrameState>& frames, int i) { frames[i].joint_velocities.fill(0.05); }
+
+}  // namespace
+
+TEST(Keyframes, GripperChangeAndLastFrame) {
+  auto frames = moving(20);
+  for (int i = 7; i < 20; ++i) frames[i].gripper_open = false;
+  EXPECT_EQ(discover_keyframes(frames), (std::vector<int>{7, 19}));
+}
+
+TEST(Keyframes, StopsWithAFourFrameBuffer) {
+  auto frames = moving(30);
+  stop_at(frames, 10);
+  stop_at(frames, 12);  // within the 4 frames after the stop at 10: not a keyframe
+  stop_at(frames, 14);  // still within them (10 is among 10..13)
+  stop_at(frames, 15);  // no stop among 11..14: a keyframe
+  EXPECT_EQ(discover_keyframes(frames), (std::vector<int>{10, 15, 29}));
+}
+
+TEST(Keyframes, VelocityThresholdIsInclusiveAndPerJoint) {
+  auto frames = moving(20);
+  stop_at(frames, 5);
+  frames[5].joint_velocities[6] = 0.1;   // exactly the threshold: still stopped
+  stop_at(frames, 12);
+  frames[12].joint_velocities[3] = -0.11;  // one joint over: moving
+  EXPECT_EQ(discover_keyframes(frames), (std::vector<int>{5, 19}));
+}
+
+TEST(Keyframes, NoStopNextToAGripperChangeOrAtTheSecondToLastFrame) {
+  auto frames = moving(20);
+  for (int i = 9; i < 20; ++i) frames[i].gripper_open = false;
+  stop_at(frames, 8);   // the gripper changes at 9: frame 8 is not a stop
+  stop_at(frames, 10);  // frame 8 (i-2) still open: not a stop either
+  stop_at(frames, 18);  // second-to-last: never a stop
+  EXPECT_EQ(discover_keyframes(frames), (std::vector<int>{9, 19}));
+}
+
+TEST(Keyframes, AdjacentFinalKeyframesKeepTheLast) {
+  auto frames = moving(12);
+  stop_at(frames, 4);
+  frames[10].gripper_open = false;  // keyframe at 10, and 11 is the last frame
+  frames[11].gripper_open = false;
+  EXPECT_EQ(discover_keyframes(frames), (std::vector<int>{4, 11}));
+}
+
+TEST(Keyframes, TooShortForAnything) {
+  EXPECT_TRUE(discover_keyframes({}).empty());
+  EXPECT_EQ(discover_keyframes(moving(1)), std::vector<int>{});
+  EXPECT_EQ(discover_keyframes(moving(2)), std::vector<int>{1});
+}
+
+TEST(RotationBins, RoundTripWithinHalfABin) {
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> angle(-M_PI, M_PI), pitch(-1.4, 1.4);
+  for (int i = 0; i < 2000; ++i) {
+    const Eigen::Vector3d a(angle(rng), pitch(rng), angle(rng));
+    const Eigen::Vector3i bins = rotation_bins(from_euler_xyz(a));
+    ASSERT_TRUE((bins.array() >= 0).all() && (bins.array() < kRotationBins).all());
+    const Eigen::Vector3d back = euler_xyz(rotation_from_bins(bins));
+    for (int k = 0; k < 3; ++k) {
+      const double difference = std::remainder(back[k] - a[k], 2 * M_PI) * 180 / M_PI;
+      EXPECT_LE(std::abs(difference), 2.5 + 1e-9) << "axis " << k;
+    }
+  }
+  // The top-down grasp: x = +-180 deg falls in bin 0 either way.
+  const Eigen::Matrix3d down = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  EXPECT_EQ(rotation_bins(down), Eigen::Vector3i(0, 36, 36));
+}
+
+TEST(CropAugmentation, TheTargetStaysInsideTheDeeperGrid) {
+  voxels::CoarseToFine h;
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> u(0, 1), shift(-0.75 * h.offset_m, 0.75 * h.offset_m);
+  for (int i = 0; i < 5000; ++i) {
+    const Eigen::Vector3d target = h.scene.min_corner + Eigen::Vector3d(u(rng), u(rng), u(rng)) * h.scene.size_m;
+    const std::vector<Eigen::Vector3d> shifts = {Eigen::Vector3d::Zero(), Eigen::Vector3d(shift(rng), shift(rng), shift(rng))};
+    const auto indices = h.indices_of(target, shifts);
+    const Eigen::Vector3d centre = h.scene.centre_of(indices[0]) + shifts[1];
+    const voxels::GridBounds deeper = h.bounds_at(1, centre);
+    EXPECT_TRUE(deeper.contains(deeper.index_of(target)));
+    EXPECT_EQ(deeper.index_of(target), indices[1]);
+  }
+}
+
+class ExpertKeyframes : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(ExpertKeyframes, MatchTheExpertsWaypoints) {
+  const robot::RobotModel robot = robot::RobotModel::xarm7();
+  demos::DemoOptions options;
+  options.episodes = {GetParam(), 0, 3, 21};
+  options.simulator.cameras[0].intrinsics.width = options.simulator.cameras[0].intrinsics.height = 32;
+  options.simulator.render_threads = 1;
+  std::vector<stream::Record> records;
+  demos::record_demos(robot, options, [&](const stream::Record& r) { records.push_back(r); },
+                      [](const std::string&) {});
+  // The expert's waypoints of each episode, from a simulator reset the same way.
+  simulator::Simulator sim(robot, options.simulator);
+  std::size_t at = 0;
+  for (int e = 0; e < 3; ++e) {
+    sim.handle(simulator::plan_reset(options.episodes, e), [](const stream::Record&) {});
+    const auto waypoints = sim.task()->expert_waypoints(*sim.world());
+    std::vector<FrameState> states;
+    std::vector<Eigen::Vector3d> positions;
+    for (; records[at].type() == "obs"; ++at) {
+      FrameState s;
+      s.gripper_open = records[at].scalar<uint8_t>("gripper_open") != 0;
+      const auto v = records[at].array<double>("joint_velocities");
+      std::copy(v.begin(), v.end(), s.joint_velocities.begin());
+      states.push_back(s);
+      const auto p = records[at].array<double>("gripper_pose");
+      positions.emplace_back(p[0], p[1], p[2]);
+    }
+    ASSERT_EQ(records[at].scalar<uint8_t>("success"), 1);
+    ++at;  // the episode record
+    const auto keyframes = discover_keyframes(states);
+    ASSERT_EQ(keyframes.size(), waypoints.size()) << GetParam() << " episode " << e;
+    for (std::size_t k = 0; k < keyframes.size(); ++k)
+      EXPECT_LT((positions[keyframes[k]] - waypoints[k].tcp_pose.translation()).norm(), 0.01875)
+          << GetParam() << " episode " << e << " keyframe " << k;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Tasks, ExpertKeyframes, ::testing::Values("reach_target", "pick_and_lift", "lift_numbered_block"));
+
+TEST(Transitions, ChainsRewardsAndReferencesToStoredFrames) {
+  const robot::RobotModel robot = robot::RobotModel::xarm7();
+  demos::DemoOptions options;
+  options.episodes = {"pick_and_lift", 0, 1, 4};
+  options.simulator.cameras[0].intrinsics.width = options.simulator.cameras[0].intrinsics.height = 32;
+  std::vector<stream::Record> out;
+  TransitionOptions transition_options;
+  EpisodeConverter converter(transition_options, [&](const stream::Record& r) { out.push_back(r); });
+  demos::record_demos(robot, options, [&](const stream::Record& r) { converter.handle(r); }, [](const std::string&) {});
+  converter.finish();
+  ASSERT_EQ(converter.counts().converted, 1);
+  std::set<int> frames;
+  int from_start = 0, rewarded = 0;
+  for (const auto& r : out) {
+    if (r.type() == "frame") {
+      frames.insert(r.scalar<int32_t>("frame"));
+      EXPECT_TRUE(r.has("front.depth_mm"));
+      EXPECT_FALSE(r.has("front.points"));
+      continue;
+    }
+    ASSERT_EQ(r.type(), "transition");
+    EXPECT_TRUE(frames.count(r.scalar<int32_t>("frame"))) << "transition before its frame";
+    EXPECT_TRUE(frames.count(r.scalar<int32_t>("next_frame")));
+    from_start += r.scalar<int32_t>("frame") == 0;
+    if (r.scalar<uint8_t>("terminal")) {
+      EXPECT_EQ(r.scalar<float>("reward"), 100.0f);
+      ++rewarded;
+    } else {
+      EXPECT_EQ(r.scalar<float>("reward"), 0.0f);
+    }
+    // The target lies in the (crop-augmented) depth-1 grid, at the stored index.
+    const auto pose = r.array<double>("target_pose");
+    const auto b = r.array<double>("depth1.bounds");
+    voxels::GridBounds deeper{{b[0], b[1], b[2]}, b[3], 16};
+    const auto index = r.array<int32_t>("depth1.index");
+    EXPECT_EQ(deeper.index_of({pose[0], pose[1], pose[2]}), Eigen::Vector3i(index[0], index[1], index[2]));
+  }
+  EXPECT_EQ(from_start, 1);            // one chain from frame 0, whose first transition starts there
+  EXPECT_GT(rewarded, 1);              // demo augmentation: several chains, each ending rewarded
+  EXPECT_EQ(converter.counts().transitions, static_cast<int64_t>(out.size() - frames.size()));
+}

@@ -1,0 +1,94 @@
+// keyframe: demonstrations to replay transitions (keyframes, demo and crop augmentation).
+#include <iostream>
+#include <sstream>
+
+#include "cli/command.hpp"
+#include "keyframes/transitions.hpp"
+#include "stream/reader.hpp"
+#include "stream/writer.hpp"
+
+using namespace qte;
+
+static cli::Usage usage() {
+  cli::Usage u;
+  u.name = "keyframe";
+  u.summary = "turn demonstrations into C2F-ARM replay transitions";
+  u.description = {
+      "Reads demonstrations (obs records at every control step, as demo-record writes them; an "
+      "episode ends at an 'episode' record or where an obs with frame 0 starts the next) and "
+      "writes the replay transitions C2F-ARM learns from. Keyframes follow the published rule: "
+      "a frame where the gripper opens or closes, the last frame, or a frame where the arm has "
+      "stopped (every joint velocity within +-0.1 rad/s, the gripper unchanged around it, no "
+      "stop in the 4 frames before, not the second-to-last frame); of two adjacent final "
+      "keyframes the first is dropped.",
+      "Besides the chain from the first frame, a chain starts at every --every-th frame (demo "
+      "augmentation), each leading through the keyframes after it. A transition's action is its "
+      "next keyframe's gripper pose: the voxel index at every depth (depth d inside the grid "
+      "centred on depth d-1's voxel, shifted by U(-0.75, 0.75) * offset per axis with crop "
+      "augmentation), rotation bins (Euler 'xyz', 72 bins of 5 degrees), gripper open/close, "
+      "ignore-collisions; reward 100 on the final transition of a successful episode, else 0.",
+      "Observations are written once each as compact 'frame' records (RGB and depth in uint16 "
+      "millimetres, zstd-compressed, camera matrices, proprioception) ahead of the 'transition' "
+      "records that refer to them by (episode_key, frame). Episodes that are empty, unsuccessful "
+      "(unless --keep-failed), have frames out of order, no keyframe, or a keyframe outside the "
+      "scene bounds are skipped and counted on standard error.",
+  };
+  u.arguments = {{"FILE", "demonstrations; '-' or absent is standard input", true, false}};
+  u.options = {
+      {"every", "N", "start a demo-augmentation chain at every N-th frame; 0 for none", "10"},
+      {"voxels", "V", "voxels per side at every depth", "16"},
+      {"depths", "D", "coarse-to-fine depths", "2"},
+      {"offset", "M", "half edge of the grids below depth 0, metres", "0.15"},
+      {"bounds", "X,Y,Z,S", "scene bounds: minimum corner and edge length, metres", "-0.3,-0.5,0.6,1.0"},
+      {"no-crop-augmentation", "", "use the unshifted centres for the deeper grids", ""},
+      {"keep-failed", "", "also convert unsuccessful episodes (reward 0 throughout)", ""},
+      {"not-demo", "", "mark the transitions as the agent's own, not demonstrations", ""},
+      {"output", "FILE", "where to write; '-' is standard output", "-"},
+      {"append", "", "append to --output (a growing replay file)", ""},
+  };
+  u.uses_randomness = true;
+  u.examples = {
+      {"demo-record --task reach_target --episodes 10 | keyframe > demo_transitions.rec",
+       "the demonstrations of a run, ready for qattn-train"},
+      {"keyframe --not-demo --every 0 --keep-failed --append --output replay.rec < episode.rec",
+       "an actor's episode added to the learner's replay"},
+  };
+  u.see_also = {"demo-record(1)", "voxelize(1)", "qattn-train(1)", "qte-stream(5)"};
+  return u;
+}
+
+static void run(const cli::Arguments& args) {
+  keyframes::TransitionOptions options;
+  options.augmentation_every_n = static_cast<int>(args.integer("every"));
+  options.hierarchy.scene.voxels = static_cast<int>(args.integer("voxels"));
+  options.hierarchy.depths = static_cast<int>(args.integer("depths"));
+  options.hierarchy.offset_m = args.real("offset");
+  std::vector<double> b;
+  std::stringstream in(args.text("bounds"));
+  for (std::string item; std::getline(in, item, ',');) b.push_back(std::atof(item.c_str()));
+  if (b.size() != 4 || !(b[3] > 0)) throw UsageError("--bounds: expected X,Y,Z,S with S > 0");
+  options.hierarchy.scene.min_corner = Eigen::Vector3d(b[0], b[1], b[2]);
+  options.hierarchy.scene.size_m = b[3];
+  options.crop_augmentation = !args.flag("no-crop-augmentation");
+  options.keep_failed = args.flag("keep-failed");
+  options.demo = !args.flag("not-demo");
+  options.seed = args.seed();
+  if (options.augmentation_every_n < 0 || options.hierarchy.depths < 1 || options.hierarchy.scene.voxels < 2 ||
+      !(options.hierarchy.offset_m > 0))
+    throw UsageError("--every >= 0, --depths >= 1, --voxels >= 2 and --offset > 0");
+
+  stream::WriteOptions write_options;
+  if (args.flag("append")) {
+    if (args.text("output") == "-") throw UsageError("--append needs --output FILE");
+    write_options.mode = stream::WriteMode::append;
+  }
+  stream::RecordReader reader(args.positional().empty() ? "-" : args.positional()[0]);
+  stream::RecordWriter writer(args.text("output"), write_options);
+  keyframes::EpisodeConverter converter(options, [&](const stream::Record& r) { writer.write(r); });
+  while (auto record = reader.next()) converter.handle(*record);
+  converter.finish();
+  writer.close();
+  std::cerr << "keyframe: " << converter.counts().summary() << "\n";
+}
+
+int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }
