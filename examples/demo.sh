@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # `make demo`: runs the toolkit's main job with the programs that exist so far, on the
-# built-in simulated tasks, and says what it did. The learning loop (voxelize, keyframe,
-# qattn-train, qte-select, plan-path, demo-record) lands with its issues; this script grows
-# with them.
+# built-in simulated tasks, and says what it did: simulation, planning, demonstrations,
+# keyframe transitions and voxel grids. The learner (qattn-train) and the agent (qte-select)
+# land with their issues; this script grows with them.
 set -euo pipefail
 out=${QTE_DEMO_DIR:-out/demo}
 rm -rf "$out" && mkdir -p "$out"
@@ -27,12 +27,24 @@ stream-png --every 8 --dir "$out/motion" "$out/motion.rec"
 stream-dump --type obs --values 3 "$out/motion.rec" > "$out/motion.txt"
 grep -E "^#|joint_positions|terminal|failure" "$out/motion.txt" | tail -6 >&2
 
-say "3. the format: any stream prints as text or JSON Lines, and exports to NumPy"
+say "3. expert demonstrations through the planner (demo-record), keyframe transitions (keyframe)"
+for task in reach_target pick_and_lift lift_numbered_block; do
+  demo-record --task "$task" --episodes 3 --seed 1 --variation random --compress --output "$out/demos_$task.rec"
+  keyframe --seed 1 --output "$out/transitions_$task.rec" "$out/demos_$task.rec"
+done
+ls -l "$out"/demos_*.rec "$out"/transitions_*.rec >&2
+
+say "4. what the agent sees: the voxel grid at depth 0 and a crop around the first keyframe (voxelize)"
+stream-cat --type obs --head 1 "$out/demos_lift_numbered_block.rec" \
+  | voxelize --png "$out/voxels" --centre 0.1,0.0,0.8 --output "$out/voxels.rec"
+ls "$out/voxels" >&2
+
+say "5. the format: any stream prints as text or JSON Lines, and exports to NumPy"
 stream-dump --json --values 2 "$out/motion.rec" > "$out/motion.jsonl"
 head -c 400 "$out/motion.jsonl" >&2; echo " ..." >&2
 stream-dump --npy "$out/npy" --type obs "$out/reach_target.rec" > /dev/null
 ls "$out/npy" >&2
 
 say "done: streams (.rec), PNG frames and .npy arrays are in $out/"
-echo "Ran: sim-step (Bullet + ray-cast cameras), stream-png, stream-pack, stream-dump." >&2
-echo "Not built yet: plan-path, demo-record, voxelize, keyframe, qattn-train, qte-select." >&2
+echo "Ran: sim-step, demo-record (with plan-path's planner), keyframe, voxelize, stream-png," >&2
+echo "stream-pack, stream-cat, stream-dump. Not built yet: qattn-train, qte-select." >&2

@@ -1,6 +1,7 @@
 #include "common/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <signal.h>
 #include <unistd.h>
 
@@ -73,6 +74,13 @@ void write_all(int fd, const void* data, std::size_t n, const std::string& what)
 
 AtomicOutputFile::AtomicOutputFile(std::string path)
     : path_(std::move(path)), temp_path_(path_ + ".tmp." + std::to_string(::getpid())) {
+  struct stat info {};
+  if (::stat(path_.c_str(), &info) == 0 && !S_ISREG(info.st_mode)) {
+    fd_ = ::open(path_.c_str(), O_WRONLY | O_CLOEXEC);
+    if (fd_ < 0) throw_system_error("cannot open " + path_);
+    temp_path_.clear();  // written in place
+    return;
+  }
   register_temp(temp_path_);
   fd_ = ::open(temp_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) {
@@ -84,8 +92,10 @@ AtomicOutputFile::AtomicOutputFile(std::string path)
 AtomicOutputFile::~AtomicOutputFile() {
   if (fd_ >= 0) {
     ::close(fd_);
-    ::unlink(temp_path_.c_str());
-    unregister_temp(temp_path_);
+    if (!temp_path_.empty()) {
+      ::unlink(temp_path_.c_str());
+      unregister_temp(temp_path_);
+    }
   }
 }
 
@@ -96,6 +106,12 @@ void AtomicOutputFile::write(const void* data, std::size_t n) {
 
 void AtomicOutputFile::commit() {
   if (fd_ < 0) return;
+  if (temp_path_.empty()) {  // a device or pipe: nothing to sync or rename
+    const int fd = fd_;
+    fd_ = -1;
+    if (::close(fd) != 0) throw_system_error("cannot close " + path_);
+    return;
+  }
   if (::fsync(fd_) != 0 && errno != EINVAL) throw_system_error("cannot sync " + path_);
   if (::close(fd_) != 0) {
     fd_ = -1;

@@ -1,6 +1,8 @@
 // Output files appear whole or not at all: bytes go to "<path>.tmp.<pid>", which commit()
 // renames to <path>. A destructor without commit(), SIGINT, SIGTERM or SIGHUP removes the
 // temporary file, so a failed or interrupted tool never leaves a half file under the final name.
+// A path that exists and is not a regular file (/dev/null, a FIFO, a terminal) is written
+// directly: renaming over it would replace the device or pipe with a file.
 #pragma once
 
 #include <cstddef>

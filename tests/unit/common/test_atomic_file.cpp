@@ -1,7 +1,11 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <sys/stat.h>
+
 #include <fstream>
+#include <iterator>
+#include <thread>
 
 #include "common/atomic_file.hpp"
 #include "stream/writer.hpp"
@@ -56,4 +60,30 @@ TEST(AtomicFile, AbandonedWriteKeepsTheOldFile) {
     w.write(stream::Record("checkpoint"));
   }
   EXPECT_EQ(std::ifstream(path, std::ios::ate).tellg(), size_before);
+}
+
+TEST(AtomicFile, DevicesAndPipesAreWrittenInPlaceNotReplaced) {
+  {
+    stream::RecordWriter w("/dev/null");
+    w.write(stream::Record("reset"));
+    w.close();
+  }
+  struct stat info {};
+  ASSERT_EQ(::stat("/dev/null", &info), 0);
+  EXPECT_TRUE(S_ISCHR(info.st_mode)) << "/dev/null was replaced by a file";
+  const std::string dir = temp_dir(), fifo = dir + "/fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::thread reader([&] {
+    std::ifstream in(fifo, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(bytes.size(), 64u);  // one record with no fields: its header
+  });
+  {
+    stream::RecordWriter w(fifo);
+    w.write(stream::Record("reset"));
+    w.close();
+  }
+  reader.join();
+  ASSERT_EQ(::stat(fifo.c_str(), &info), 0);
+  EXPECT_TRUE(S_ISFIFO(info.st_mode));
 }
