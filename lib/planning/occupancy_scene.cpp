@@ -176,6 +176,12 @@ bool OccupancyScene::collides(const std::vector<Sphere>& spheres, double clearan
   return false;
 }
 
+OccupancyScene::Occupancy OccupancyScene::occupancy_at(const Eigen::Vector3d& p) const {
+  const octomap::OcTreeNode* node = impl_->tree.search(p.x(), p.y(), p.z());
+  if (!node) return Occupancy::unknown;
+  return impl_->tree.isNodeOccupied(node) ? Occupancy::occupied : Occupancy::free;
+}
+
 std::size_t OccupancyScene::occupied_voxels() const {
   const octomap::OcTree& tree = impl_->tree;
   const unsigned depth = tree.getTreeDepth();

@@ -47,6 +47,10 @@ class OccupancyScene {
   bool collides(const std::vector<Sphere>& spheres, double clearance_m = 0.0) const;
 
   // Occupied voxels at the map resolution (pruned octree nodes count for all they cover).
+  // What the map knows about the point: never observed, observed free, or occupied.
+  enum class Occupancy { unknown, free, occupied };
+  Occupancy occupancy_at(const Eigen::Vector3d& p) const;
+
   std::size_t occupied_voxels() const;
   // Their centres, world frame: for tests and visualisation.
   std::vector<Eigen::Vector3d> occupied_voxel_centres() const;

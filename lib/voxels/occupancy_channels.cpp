@@ -1,0 +1,56 @@
+#include "voxels/occupancy_channels.hpp"
+
+#include "planning/occupancy_scene.hpp"
+#include "voxels/observation_cloud.hpp"
+
+namespace qte::voxels {
+
+struct ObservedSpace::Impl {
+  planning::OccupancyScene scene;
+  explicit Impl(const planning::SceneOptions& options) : scene(options) {}
+};
+
+ObservedSpace::ObservedSpace(const stream::Record& obs, double resolution_m) {
+  planning::SceneOptions options;
+  options.resolution_m = resolution_m;
+  impl_ = std::make_unique<Impl>(options);
+  const std::string suffix = ".extrinsics";
+  for (const auto& field : obs.fields()) {
+    const std::string& name = field.name();
+    if (name.size() <= suffix.size() || name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) continue;
+    const std::string camera = name.substr(0, name.size() - suffix.size());
+    stream::Record one("obs");  // one camera at a time: its rays start at its own origin
+    for (const char* part : {".rgb", ".points", ".depth", ".depth_mm", ".intrinsics", ".extrinsics"})
+      if (obs.has(camera + part)) one.add(obs.field(camera + part));
+    one.position = obs.position;
+    const ObservationCloud cloud = observation_cloud(one);
+    const auto e = obs.array<double>(name);
+    impl_->scene.insert_camera(cloud.xyz.data(), cloud.rgb.size() / 3, Eigen::Vector3d(e[3], e[7], e[11]), {}, {});
+  }
+}
+
+ObservedSpace::~ObservedSpace() = default;
+
+void ObservedSpace::channels(const GridBounds& bounds, float* out) const {
+  const int v = bounds.voxels;
+  for (int x = 0, flat = 0; x < v; ++x)
+    for (int y = 0; y < v; ++y)
+      for (int z = 0; z < v; ++z, ++flat) {
+        const auto state = impl_->scene.occupancy_at(bounds.centre_of({x, y, z}));
+        out[kOccupancyChannels * flat + 0] = state == planning::OccupancyScene::Occupancy::free ? 1.0f : 0.0f;
+        out[kOccupancyChannels * flat + 1] = state == planning::OccupancyScene::Occupancy::unknown ? 1.0f : 0.0f;
+      }
+}
+
+std::vector<float> append_channels(const float* grid, const float* extra, int voxels, int extra_count) {
+  const std::size_t cells = static_cast<std::size_t>(voxels) * voxels * voxels;
+  const int total = kChannels + extra_count;
+  std::vector<float> out(cells * total);
+  for (std::size_t i = 0; i < cells; ++i) {
+    std::copy(grid + i * kChannels, grid + (i + 1) * kChannels, out.begin() + i * total);
+    std::copy(extra + i * extra_count, extra + (i + 1) * extra_count, out.begin() + i * total + kChannels);
+  }
+  return out;
+}
+
+}  // namespace qte::voxels
