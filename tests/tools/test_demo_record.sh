@@ -1,11 +1,6 @@
 #!/usr/bin/env bash
 # demo-record: full demonstrations, marked episodes, determinism.
-set -uo pipefail
-tools=${QTE_TOOLS:?}
-export PATH="$tools:$PATH"
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+source "$(dirname "$0")/common.sh"
 
 demo-record --task pick_and_lift --episodes 2 --seed 5 --image-size 64x64 --output "$tmp/a.rec" 2> "$tmp/log" || fail "exit $?"
 grep -q "expert success 2/2" "$tmp/log" || fail "expert did not succeed: $(cat "$tmp/log")"

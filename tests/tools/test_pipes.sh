@@ -1,12 +1,7 @@
 #!/usr/bin/env bash
 # Streams through pipes: records pass unchanged, a reader that quits early stops the writer
 # quietly (no error message, no hang), binary output to a terminal is refused.
-set -uo pipefail
-tools=${QTE_TOOLS:?}
-export PATH="$tools:$PATH"
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+source "$(dirname "$0")/common.sh"
 
 for i in $(seq 1 50); do stream-pack obs "step:i32=$i" "x:f32[1000]=$(seq -s, 1 1000)"; done > "$tmp/many.rec"
 cmp "$tmp/many.rec" <(stream-cat < "$tmp/many.rec") || fail "stream-cat changed the bytes"

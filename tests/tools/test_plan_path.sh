@@ -1,11 +1,6 @@
 #!/usr/bin/env bash
 # plan-path between the simulator's observations and its trajectories.
-set -uo pipefail
-tools=${QTE_TOOLS:?}
-export PATH="$tools:$PATH"
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+source "$(dirname "$0")/common.sh"
 
 stream-pack reset task=pick_and_lift seed:i64=2 > "$tmp/reset.rec"
 sim-step < "$tmp/reset.rec" > "$tmp/obs.rec" || fail "sim-step"

@@ -1,11 +1,6 @@
 #!/usr/bin/env bash
 # sim-step as a program: observations on reset, same seed -> same bytes, clear errors.
-set -uo pipefail
-tools=${QTE_TOOLS:?}
-export PATH="$tools:$PATH"
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+source "$(dirname "$0")/common.sh"
 
 sim-step --task pick_and_lift --seed 4 --image-size 64x64 < /dev/null > "$tmp/a.rec" || fail "sim-step exit $?"
 sim-step --task pick_and_lift --seed 4 --image-size 64x64 < /dev/null > "$tmp/b.rec"

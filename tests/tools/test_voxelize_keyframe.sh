@@ -1,11 +1,6 @@
 #!/usr/bin/env bash
 # voxelize and keyframe as programs: demos -> transitions, observations -> grids, bad input.
-set -uo pipefail
-tools=${QTE_TOOLS:?}
-export PATH="$tools:$PATH"
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+source "$(dirname "$0")/common.sh"
 
 demo-record --task lift_numbered_block --episodes 2 --seed 3 --image-size 48x48 --output "$tmp/demos.rec" 2>/dev/null \
   || fail "demo-record"

@@ -8,16 +8,14 @@
 #include "planning/motion_planner.hpp"
 #include "planning/time_parametrization.hpp"
 #include "simulator/simulator.hpp"
+#include "test_support.hpp"
 
 using namespace qte;
 using namespace qte::planning;
 
 namespace {
 
-const robot::RobotModel& xarm() {
-  static const robot::RobotModel robot = robot::RobotModel::xarm7();
-  return robot;
-}
+using test_support::xarm;
 
 struct Scene {
   simulator::Simulator sim{xarm(), [] {

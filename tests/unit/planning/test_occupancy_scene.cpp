@@ -10,16 +10,14 @@
 
 #include "planning/occupancy_scene.hpp"
 #include "simulator/simulator.hpp"
+#include "test_support.hpp"
 
 using namespace qte;
 using namespace qte::planning;
 
 namespace {
 
-const robot::RobotModel& xarm() {
-  static const robot::RobotModel robot = robot::RobotModel::xarm7();
-  return robot;
-}
+using test_support::xarm;
 
 // One observation of pick_and_lift (variation 0, seed 3) and what the world knew then.
 struct Observation {

@@ -8,16 +8,14 @@
 #include "common/error.hpp"
 #include "planning/robot_spheres.hpp"
 #include "sim/world.hpp"
+#include "test_support.hpp"
 
 using namespace qte;
 using namespace qte::planning;
 
 namespace {
 
-const robot::RobotModel& xarm() {
-  static const robot::RobotModel robot = robot::RobotModel::xarm7();
-  return robot;
-}
+using test_support::xarm;
 
 // Points on the surface of a primitive, in its own frame, about `step` apart.
 std::vector<Eigen::Vector3d> surface_points(const robot::Shape& shape, double step) {

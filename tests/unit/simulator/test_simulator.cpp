@@ -4,16 +4,14 @@
 #include "trajectory_helpers.hpp"
 #include "stream/codec.hpp"
 #include "tasks/task.hpp"
+#include "test_support.hpp"
 
 using namespace qte;
 using namespace qte::simulator;
 
 namespace {
 
-const robot::RobotModel& xarm() {
-  static const robot::RobotModel robot = robot::RobotModel::xarm7();
-  return robot;
-}
+using test_support::xarm;
 
 SimulatorOptions small_options() {
   SimulatorOptions options;
