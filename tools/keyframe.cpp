@@ -1,6 +1,5 @@
 // keyframe: demonstrations to replay transitions (keyframes, demo and crop augmentation).
 #include <iostream>
-#include <sstream>
 
 #include "cli/command.hpp"
 #include "keyframes/transitions.hpp"
@@ -60,15 +59,9 @@ static cli::Usage usage() {
 static void run(const cli::Arguments& args) {
   keyframes::TransitionOptions options;
   options.augmentation_every_n = static_cast<int>(args.integer("every"));
-  options.hierarchy.scene.voxels = static_cast<int>(args.integer("voxels"));
+  options.hierarchy.scene = voxels::GridBounds::parse(args.text("bounds"), static_cast<int>(args.integer("voxels")));
   options.hierarchy.depths = static_cast<int>(args.integer("depths"));
   options.hierarchy.offset_m = args.real("offset");
-  std::vector<double> b;
-  std::stringstream in(args.text("bounds"));
-  for (std::string item; std::getline(in, item, ',');) b.push_back(std::atof(item.c_str()));
-  if (b.size() != 4 || !(b[3] > 0)) throw UsageError("--bounds: expected X,Y,Z,S with S > 0");
-  options.hierarchy.scene.min_corner = Eigen::Vector3d(b[0], b[1], b[2]);
-  options.hierarchy.scene.size_m = b[3];
   options.crop_augmentation = !args.flag("no-crop-augmentation");
   options.keep_failed = args.flag("keep-failed");
   options.demo = !args.flag("not-demo");
@@ -78,10 +71,7 @@ static void run(const cli::Arguments& args) {
     throw UsageError("--every >= 0, --depths >= 1, --voxels >= 2 and --offset > 0");
 
   stream::WriteOptions write_options;
-  if (args.flag("append")) {
-    if (args.text("output") == "-") throw UsageError("--append needs --output FILE");
-    write_options.mode = stream::WriteMode::append;
-  }
+  if (args.flag("append")) write_options.mode = stream::WriteMode::append;
   stream::RecordReader reader(args.positional().empty() ? "-" : args.positional()[0]);
   stream::RecordWriter writer(args.text("output"), write_options);
   keyframes::EpisodeConverter converter(options, [&](const stream::Record& r) { writer.write(r); });

@@ -49,10 +49,7 @@ static void run(const cli::Arguments& args) {
   if (args.integer("max-record-bytes") <= 0) throw UsageError("--max-record-bytes must be positive");
   read_options.max_record_bytes = static_cast<uint64_t>(args.integer("max-record-bytes"));
   stream::WriteOptions write_options;
-  if (args.flag("append")) {
-    if (args.text("output") == "-") throw UsageError("--append needs --output FILE");
-    write_options.mode = stream::WriteMode::append;
-  }
+  if (args.flag("append")) write_options.mode = stream::WriteMode::append;
   stream::RecordWriter writer(args.text("output"), write_options);
   for (const std::string& file : files) {
     stream::RecordReader reader(file, read_options);

@@ -51,10 +51,7 @@ static void run(const cli::Arguments& args) {
     record = std::move(compressed);
   }
   stream::WriteOptions options;
-  if (args.flag("append")) {
-    if (args.text("output") == "-") throw UsageError("--append needs --output FILE");
-    options.mode = stream::WriteMode::append;
-  }
+  if (args.flag("append")) options.mode = stream::WriteMode::append;
   stream::RecordWriter writer(args.text("output"), options);
   writer.write(record);
   writer.close();

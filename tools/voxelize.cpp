@@ -73,13 +73,8 @@ static std::vector<double> numbers(const std::string& option, const std::string&
 }
 
 static void run(const cli::Arguments& args) {
-  voxels::GridBounds scene;
-  scene.voxels = static_cast<int>(args.integer("voxels"));
-  if (scene.voxels < 2 || scene.voxels > 256) throw UsageError("--voxels must be 2-256");
-  const auto b = numbers("bounds", args.text("bounds"), 4);
-  scene.min_corner = Eigen::Vector3d(b[0], b[1], b[2]);
-  scene.size_m = b[3];
-  if (!(scene.size_m > 0)) throw UsageError("--bounds: the edge length must be positive");
+  const voxels::GridBounds scene = voxels::GridBounds::parse(args.text("bounds"), static_cast<int>(args.integer("voxels")));
+  if (scene.voxels > 256) throw UsageError("--voxels must be 2-256");
   const double offset = args.real("offset");
   std::vector<voxels::GridBounds> crops;
   for (const auto& c : args.all("centre")) {
@@ -113,7 +108,8 @@ static void run(const cli::Arguments& args) {
     const int64_t channels = voxels::kChannels + (space ? voxels::kOccupancyChannels : 0);
     stream::Record out("voxels");
     out.set<float>("depth0.grid", {v, v, v, channels}, with_channels(grid.data(), scene));
-    out.set<double>("depth0.bounds", {4}, std::vector<double>{b[0], b[1], b[2], b[3]});
+    out.set<double>("depth0.bounds", {4}, std::vector<double>{scene.min_corner.x(), scene.min_corner.y(),
+                                                              scene.min_corner.z(), scene.size_m});
     if (!crops.empty()) {
       voxels::voxelize_many(cloud.view(), crops, crop_grids.data());
       const int64_t k = static_cast<int64_t>(crops.size());

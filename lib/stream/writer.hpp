@@ -13,7 +13,8 @@ namespace qte::stream {
 
 enum class WriteMode {
   replace,  // the file appears complete on close() (temporary name + rename)
-  append,   // each record is appended whole under an exclusive lock (replay logs, many actors)
+  append,   // each record is appended whole under an exclusive lock (replay logs, many actors);
+            // for "-" the same as replace: standard output is a stream either way
 };
 
 struct WriteOptions {

@@ -1,6 +1,8 @@
 #include "voxels/voxel_grid.hpp"
 
 #include <cmath>
+#include <algorithm>
+#include <cstdlib>
 #include <cstring>
 
 #include "common/error.hpp"
@@ -25,6 +27,27 @@ GridBounds GridBounds::around(const Eigen::Vector3d& centre, double half_extent_
   GridBounds b;
   b.min_corner = centre - Eigen::Vector3d::Constant(half_extent_m);
   b.size_m = 2 * half_extent_m;
+  b.voxels = voxels;
+  return b;
+}
+
+GridBounds GridBounds::parse(const std::string& text, int voxels) {
+  std::vector<double> v;
+  std::size_t at = 0;
+  while (at <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', at), text.size());
+    const std::string item = text.substr(at, comma - at);
+    char* end = nullptr;
+    v.push_back(std::strtod(item.c_str(), &end));
+    if (item.empty() || *end != '\0') throw Error("bounds '" + text + "': '" + item + "' is not a number");
+    at = comma + 1;
+  }
+  if (v.size() != 4 || !(v[3] > 0) || !std::isfinite(v[0] + v[1] + v[2] + v[3]))
+    throw Error("bounds '" + text + "': expected X,Y,Z,S (minimum corner and a positive edge length, metres)");
+  if (voxels < 2) throw Error("a grid needs at least 2 voxels per side");
+  GridBounds b;
+  b.min_corner = Eigen::Vector3d(v[0], v[1], v[2]);
+  b.size_m = v[3];
   b.voxels = voxels;
   return b;
 }

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace qte::voxels {
@@ -24,6 +25,9 @@ struct GridBounds {
   bool contains(const Eigen::Vector3i& index) const;
   // The cube of half-size `half_extent_m` centred on `centre`.
   static GridBounds around(const Eigen::Vector3d& centre, double half_extent_m, int voxels);
+  // From "X,Y,Z,S" (minimum corner and edge length, metres), as the tools' --bounds give it.
+  // Throws Error on anything else.
+  static GridBounds parse(const std::string& text, int voxels);
 };
 
 // The hierarchy: scene bounds at depth 0, `depths` levels of `voxels`^3, offset 0.15 m.
