@@ -186,3 +186,54 @@ TEST(Transitions, ChainsRewardsAndReferencesToStoredFrames) {
   EXPECT_GT(rewarded, 1);              // demo augmentation: several chains, each ending rewarded
   EXPECT_EQ(converter.counts().transitions, static_cast<int64_t>(out.size() - frames.size()));
 }
+
+namespace {
+
+// A synthetic demonstration: n obs records moving along x, the gripper closing at `close_at`.
+std::vector<stream::Record> synthetic_demo(int n, int close_at, double x0 = 0.1) {
+  std::vector<stream::Record> demo;
+  for (int i = 0; i < n; ++i) {
+    stream::Record obs("obs");
+    obs.set_scalar<int32_t>("frame", i);
+    obs.set_scalar<uint8_t>("gripper_open", i < close_at);
+    obs.set<double>("joint_velocities", {7}, std::vector<double>(7, i == n - 1 ? 0.0 : 0.5));
+    obs.set<double>("gripper_pose", {7}, std::vector<double>{x0 + 0.01 * i, 0.0, 0.9, 1, 0, 0, 0});
+    obs.set_scalar<uint8_t>("success", i == n - 1);
+    obs.set_string("task", "synthetic");
+    demo.push_back(obs);
+  }
+  return demo;
+}
+
+}  // namespace
+
+TEST(Transitions, BadEpisodesAreSkippedAndCounted) {
+  auto good = synthetic_demo(12, 6);
+  auto empty = std::vector<stream::Record>{};
+  auto single = synthetic_demo(1, 5);
+  auto out_of_order = synthetic_demo(12, 6);
+  std::swap(out_of_order[3], out_of_order[4]);
+  auto outside = synthetic_demo(12, 6, /*x0=*/0.95);  // x beyond the scene's 0.7
+  auto failed = synthetic_demo(12, 6);
+  failed.back().set_scalar<uint8_t>("success", 0);
+  // Each episode ends with an 'episode' record without a success field: use the last obs's.
+  std::vector<stream::Record> out;
+  EpisodeConverter converter(TransitionOptions{}, [&](const stream::Record& r) { out.push_back(r); });
+  for (const auto* episode : {&good, &empty, &single, &out_of_order, &outside, &failed}) {
+    for (const auto& r : *episode) converter.handle(r);
+    stream::Record end("episode");
+    end.set_scalar<uint8_t>("success", episode->empty() ? 0 : episode->back().scalar<uint8_t>("success"));
+    converter.handle(end);
+  }
+  const ConversionCounts& c = converter.counts();
+  EXPECT_EQ(c.episodes, 6);
+  EXPECT_EQ(c.converted, 1);
+  EXPECT_EQ(c.skipped_empty, 2);  // no frames, one frame
+  EXPECT_EQ(c.skipped_out_of_order, 1);
+  EXPECT_EQ(c.skipped_outside_bounds, 1);
+  EXPECT_EQ(c.skipped_failed, 1);
+  EXPECT_NE(c.summary().find("skipped 1 with frames out of order"), std::string::npos);
+  // The good one: keyframes at the gripper change (6) and the last frame (11); one chain from
+  // frame 0 and one from frame 10 (demo augmentation): 2 + 1 transitions.
+  EXPECT_EQ(c.transitions, 3);
+}

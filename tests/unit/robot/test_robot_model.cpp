@@ -30,6 +30,26 @@ TEST(RobotModel, ZeroPoseMatchesTheDhTable) {
   EXPECT_NEAR(flange.translation().z(), 0.267 + 0.293 - 0.3425 - 0.097, 1e-9);
 }
 
+TEST(RobotModel, KnownConfigurations) {
+  const RobotModel robot = RobotModel::xarm7();
+  const int flange = robot.link_index("link7");
+  // Joint 1 at +90 deg turns the zero pose about the base: x goes to y.
+  JointVector q = JointVector::Zero();
+  q[0] = M_PI / 2;
+  Eigen::Vector3d p = robot.link_poses(q, 0)[flange].translation();
+  EXPECT_NEAR(p.x(), 0.0, 1e-9);
+  EXPECT_NEAR(p.y(), 0.206, 1e-9);
+  EXPECT_NEAR(p.z(), 0.1205, 1e-9);
+  // Joint 4 at +90 deg turns the hanging forearm forward: its 0.3425 m length, pointing down
+  // at zero, now points along +x from the elbow (0.0525 forward, 0.267 + 0.293 up), and its
+  // 0.0775 offset, along +x at zero, now points up.
+  q = JointVector::Zero();
+  q[3] = M_PI / 2;
+  p = robot.link_poses(q, 0)[robot.link_index("link5")].translation();
+  EXPECT_NEAR(p.z(), 0.267 + 0.293 + 0.0775, 1e-9);
+  EXPECT_NEAR(p.x(), 0.0525 + 0.3425, 1e-9);
+}
+
 TEST(RobotModel, ReachBracketsTheDatasheets700mm) {
   const RobotModel robot = RobotModel::xarm7();
   // Largest distance from the shoulder (joint 2 axis) over random poses: the wrist centre
