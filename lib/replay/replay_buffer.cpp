@@ -1,0 +1,107 @@
+#include "replay/replay_buffer.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/error.hpp"
+
+namespace qte::replay {
+
+ReplayBuffer::ReplayBuffer(ReplayOptions options) : options_(options), tree_(options.capacity) {
+  if (options_.capacity == 0) throw Error("replay capacity must be at least 1");
+}
+
+bool ReplayBuffer::add(const stream::Record& record) {
+  if (record.type() == "frame") {
+    const FrameKey key{record.scalar<int64_t>("episode_key"), record.scalar<int32_t>("frame")};
+    auto it = frames_.find(key);
+    if (it == frames_.end()) frames_.emplace(key, std::make_pair(record, 0));
+    return true;
+  }
+  if (record.type() != "transition") return false;
+  Stored stored{record,
+                {record.scalar<int64_t>("episode_key"), record.scalar<int32_t>("frame")},
+                {record.scalar<int64_t>("episode_key"), record.scalar<int32_t>("next_frame")},
+                record.has("demo") && record.scalar<uint8_t>("demo") != 0};
+  for (const FrameKey* key : {&stored.frame, &stored.next_frame})
+    if (!frames_.count(*key))
+      throw StreamError(record.position, "transition refers to frame " + std::to_string(key->second) +
+                                             " of episode " + std::to_string(key->first) +
+                                             ", which no 'frame' record before it holds");
+  // Count the new references first: the transition evicted below may share a frame.
+  frames_.at(stored.frame).second += 1;
+  frames_.at(stored.next_frame).second += 1;
+  std::size_t slot = transitions_.size();
+  if (transitions_.size() == options_.capacity) {
+    // Full: replace the oldest of the agent's transitions; with only demos, keep what we have.
+    std::size_t checked = 0;
+    while (checked < transitions_.size() && transitions_[next_evicted_].demo) {
+      next_evicted_ = (next_evicted_ + 1) % transitions_.size();
+      ++checked;
+    }
+    if (checked == transitions_.size()) {
+      release(stored.frame);
+      release(stored.next_frame);
+      return false;
+    }
+    slot = next_evicted_;
+    next_evicted_ = (next_evicted_ + 1) % transitions_.size();
+    release(transitions_[slot].frame);
+    release(transitions_[slot].next_frame);
+    demos_ -= transitions_[slot].demo;
+  }
+  demos_ += stored.demo;
+  if (slot == transitions_.size()) transitions_.push_back(std::move(stored));
+  else transitions_[slot] = std::move(stored);
+  tree_.set(slot, options_.prioritised ? tree_.max() : 1.0);  // new: sampled at least once soon
+  return true;
+}
+
+void ReplayBuffer::release(const FrameKey& key) {
+  auto it = frames_.find(key);
+  if (it != frames_.end() && --it->second.second <= 0) frames_.erase(it);
+}
+
+Sample ReplayBuffer::sample(std::size_t batch, double beta, std::mt19937_64& rng) const {
+  if (transitions_.empty()) throw Error("cannot sample from an empty replay");
+  Sample s;
+  const double n = static_cast<double>(transitions_.size());
+  if (!options_.prioritised) {
+    std::uniform_int_distribution<std::size_t> pick(0, transitions_.size() - 1);
+    for (std::size_t i = 0; i < batch; ++i) s.indices.push_back(pick(rng));
+    s.weights.assign(batch, 1.0);
+    return s;
+  }
+  // Stratified: one draw per equal slice of the total priority mass.
+  const double total = tree_.total(), slice = total / batch;
+  for (std::size_t i = 0; i < batch; ++i) {
+    const double mass = std::min(total * (1 - 1e-12), (i + std::uniform_real_distribution<double>(0, 1)(rng)) * slice);
+    s.indices.push_back(std::min(tree_.find(mass), transitions_.size() - 1));
+  }
+  double max_weight = 0;
+  for (std::size_t index : s.indices) {
+    const double p = tree_.get(index) / total;
+    s.weights.push_back(std::pow(n * p, -beta));
+    max_weight = std::max(max_weight, s.weights.back());
+  }
+  for (double& w : s.weights) w /= max_weight;
+  return s;
+}
+
+void ReplayBuffer::update_priorities(const std::vector<std::size_t>& indices, const std::vector<double>& td_errors) {
+  if (!options_.prioritised) return;
+  for (std::size_t i = 0; i < indices.size(); ++i) {
+    if (!std::isfinite(td_errors[i])) throw Error("non-finite TD error for transition " + std::to_string(indices[i]));
+    tree_.set(indices[i], std::pow(std::abs(td_errors[i]) + options_.priority_epsilon, options_.alpha));
+  }
+}
+
+const stream::Record& ReplayBuffer::frame_of(std::size_t index) const {
+  return frames_.at(transitions_.at(index).frame).first;
+}
+
+const stream::Record& ReplayBuffer::next_frame_of(std::size_t index) const {
+  return frames_.at(transitions_.at(index).next_frame).first;
+}
+
+}  // namespace qte::replay

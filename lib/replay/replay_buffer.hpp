@@ -1,0 +1,68 @@
+// The learner's replay: frames (observations stored once) and the transitions that refer to
+// them, with prioritised sampling (priority = (|TD error| + eps)^alpha, importance weights
+// (N * P(i))^-beta normalised by their maximum) or uniform sampling. Demonstrations are kept
+// for good; when full, the oldest of the agent's own transitions makes room.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "replay/sum_tree.hpp"
+#include "stream/record.hpp"
+
+namespace qte::replay {
+
+struct ReplayOptions {
+  std::size_t capacity = 100000;  // transitions
+  bool prioritised = true;
+  double alpha = 0.7;
+  double priority_epsilon = 1e-3;
+};
+
+struct Sample {
+  std::vector<std::size_t> indices;
+  std::vector<double> weights;  // importance weights, max 1 (all 1 when uniform)
+};
+
+class ReplayBuffer {
+ public:
+  explicit ReplayBuffer(ReplayOptions options = {});
+
+  // Takes 'frame' and 'transition' records (others are ignored). A transition must follow
+  // the frames it refers to: otherwise a StreamError names it. Returns true if it was kept.
+  bool add(const stream::Record& record);
+
+  std::size_t size() const { return transitions_.size(); }
+  std::size_t demo_count() const { return demos_; }
+  std::size_t frame_count() const { return frames_.size(); }
+
+  Sample sample(std::size_t batch, double beta, std::mt19937_64& rng) const;
+  void update_priorities(const std::vector<std::size_t>& indices, const std::vector<double>& td_errors);
+  double priority(std::size_t index) const { return tree_.get(index); }
+
+  const stream::Record& transition(std::size_t index) const { return transitions_.at(index).record; }
+  // The observation a transition acts on, and the one it reaches.
+  const stream::Record& frame_of(std::size_t index) const;
+  const stream::Record& next_frame_of(std::size_t index) const;
+
+ private:
+  using FrameKey = std::pair<int64_t, int32_t>;  // (episode_key, frame)
+  struct Stored {
+    stream::Record record;
+    FrameKey frame, next_frame;
+    bool demo = false;
+  };
+  void release(const FrameKey& key);
+
+  ReplayOptions options_;
+  std::vector<Stored> transitions_;
+  std::map<FrameKey, std::pair<stream::Record, int>> frames_;  // frame and its reference count
+  SumTree tree_;
+  std::size_t demos_ = 0;
+  std::size_t next_evicted_ = 0;  // ring position among the agent's transitions
+};
+
+}  // namespace qte::replay

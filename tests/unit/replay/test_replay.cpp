@@ -1,0 +1,145 @@
+// Prioritised replay: proportional sampling, importance weights, eviction that keeps
+// demonstrations, references to frames, and files that grow while being read.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <fstream>
+
+#include "replay/growing_stream.hpp"
+#include "replay/replay_buffer.hpp"
+#include "stream/codec.hpp"
+
+using namespace qte;
+using namespace qte::replay;
+
+namespace {
+
+stream::Record frame(int64_t episode, int32_t index) {
+  stream::Record f("frame");
+  f.set_scalar<int64_t>("episode_key", episode);
+  f.set_scalar<int32_t>("frame", index);
+  return f;
+}
+
+stream::Record transition(int64_t episode, int32_t from, int32_t to, bool demo) {
+  stream::Record t("transition");
+  t.set_scalar<int64_t>("episode_key", episode);
+  t.set_scalar<int32_t>("frame", from);
+  t.set_scalar<int32_t>("next_frame", to);
+  t.set_scalar<uint8_t>("demo", demo);
+  return t;
+}
+
+void add_episode(ReplayBuffer& replay, int64_t episode, int transitions, bool demo) {
+  for (int i = 0; i <= transitions; ++i) replay.add(frame(episode, i));
+  for (int i = 0; i < transitions; ++i) replay.add(transition(episode, i, i + 1, demo));
+}
+
+}  // namespace
+
+TEST(SumTree, FindsProportionallyAndStaysExact) {
+  SumTree tree(5);
+  const double p[5] = {1, 0, 3, 0.5, 0.5};
+  for (int i = 0; i < 5; ++i) tree.set(i, p[i]);
+  EXPECT_DOUBLE_EQ(tree.total(), 5.0);
+  EXPECT_EQ(tree.find(0.5), 0u);
+  EXPECT_EQ(tree.find(1.0), 2u);  // index 1 has no mass
+  EXPECT_EQ(tree.find(3.99), 2u);
+  EXPECT_EQ(tree.find(4.2), 3u);
+  EXPECT_EQ(tree.find(4.9), 4u);
+  for (int k = 0; k < 100000; ++k) tree.set(k % 5, 0.1 * (k % 7));
+  double sum = 0;
+  for (int i = 0; i < 5; ++i) sum += tree.get(i);
+  EXPECT_DOUBLE_EQ(tree.total(), sum);
+}
+
+TEST(ReplayBuffer, SamplesInProportionToPriorityWithImportanceWeights) {
+  ReplayBuffer replay;
+  add_episode(replay, 1, 4, true);
+  replay.update_priorities({0, 1, 2, 3}, {0.0, 1.0, 1.0, 8.0});
+  std::mt19937_64 rng(3);
+  std::vector<int> counts(4, 0);
+  for (int round = 0; round < 2000; ++round) {
+    const Sample s = replay.sample(8, 0.5, rng);
+    double max_weight = 0;
+    for (std::size_t i = 0; i < s.indices.size(); ++i) {
+      counts[s.indices[i]] += 1;
+      EXPECT_LE(s.weights[i], 1.0 + 1e-12);
+      max_weight = std::max(max_weight, s.weights[i]);
+    }
+    EXPECT_DOUBLE_EQ(max_weight, 1.0);
+  }
+  // priorities (|td| + 1e-3)^0.7: 0.008, 1.0007, 1.0007, 4.29
+  const double expected3 = std::pow(8.001, 0.7) / (std::pow(0.001, 0.7) + 2 * std::pow(1.001, 0.7) + std::pow(8.001, 0.7));
+  EXPECT_NEAR(counts[3] / 16000.0, expected3, 0.02);
+  EXPECT_LT(counts[0], 100);
+  EXPECT_NEAR(counts[1], counts[2], 400);
+}
+
+TEST(ReplayBuffer, UniformWhenAsked) {
+  ReplayOptions options;
+  options.prioritised = false;
+  ReplayBuffer replay(options);
+  add_episode(replay, 1, 4, false);
+  replay.update_priorities({3}, {100.0});  // ignored
+  std::mt19937_64 rng(4);
+  std::vector<int> counts(4, 0);
+  for (int round = 0; round < 4000; ++round)
+    for (std::size_t i : replay.sample(4, 1.0, rng).indices) counts[i] += 1;
+  for (int c : counts) EXPECT_NEAR(c, 4000, 300);
+}
+
+TEST(ReplayBuffer, FullReplaysEvictTheOldestAgentTransitionsAndKeepDemos) {
+  ReplayOptions options;
+  options.capacity = 6;
+  ReplayBuffer replay(options);
+  add_episode(replay, 1, 3, true);    // 3 demo transitions
+  add_episode(replay, 2, 3, false);   // full
+  add_episode(replay, 3, 2, false);   // replaces episode 2's first two
+  EXPECT_EQ(replay.size(), 6u);
+  EXPECT_EQ(replay.demo_count(), 3u);
+  int from_episode[4] = {0, 0, 0, 0};
+  for (std::size_t i = 0; i < replay.size(); ++i) from_episode[replay.transition(i).scalar<int64_t>("episode_key")] += 1;
+  EXPECT_EQ(from_episode[1], 3);
+  EXPECT_EQ(from_episode[2], 1);
+  EXPECT_EQ(from_episode[3], 2);
+  // Frames nothing refers to any more are released: episode 2 keeps frames 2 and 3 only.
+  EXPECT_EQ(replay.frame_count(), 4u + 2u + 3u);
+}
+
+TEST(ReplayBuffer, TransitionsNeedTheirFramesFirst) {
+  ReplayBuffer replay;
+  replay.add(frame(1, 0));
+  stream::Record t = transition(1, 0, 5, false);
+  t.position.source = "replay.rec";
+  t.position.record_index = 7;
+  try {
+    replay.add(t);
+    FAIL();
+  } catch (const StreamError& e) {
+    EXPECT_NE(std::string(e.what()).find("replay.rec: record 7 at byte 0: transition refers to frame 5"), std::string::npos);
+  }
+}
+
+TEST(GrowingStream, ReturnsWholeRecordsAsTheyArrive) {
+  char path[] = "/tmp/qte_growing_XXXXXX";
+  const int fd = ::mkstemp(path);
+  ASSERT_GE(fd, 0);
+  const auto a = stream::encode_record(frame(1, 0)), b = stream::encode_record(frame(1, 1));
+  ASSERT_EQ(::write(fd, a.data(), a.size()), static_cast<ssize_t>(a.size()));
+  GrowingStream growing(path);
+  EXPECT_EQ(growing.poll().size(), 1u);
+  EXPECT_TRUE(growing.poll().empty());
+  ASSERT_EQ(::write(fd, b.data(), 70), 70);  // half a record: not yet
+  EXPECT_TRUE(growing.poll().empty());
+  ASSERT_EQ(::write(fd, b.data() + 70, b.size() - 70), static_cast<ssize_t>(b.size() - 70));
+  const auto records = growing.poll();
+  ASSERT_EQ(records.size(), 1u);
+  EXPECT_EQ(records[0].scalar<int32_t>("frame"), 1);
+  EXPECT_EQ(records[0].position.record_index, 1u);
+  const uint8_t junk[64] = {1, 2, 3};
+  ASSERT_EQ(::write(fd, junk, sizeof junk), 64);
+  EXPECT_THROW(growing.poll(), StreamError);
+  ::close(fd);
+  ::unlink(path);
+}
