@@ -1,0 +1,236 @@
+#include "nets/checkpoint.hpp"
+
+#include <cctype>
+#include <map>
+#include <set>
+
+#include "common/error.hpp"
+#include "nets/qattention_modules.hpp"
+#include "stream/reader.hpp"
+#include "stream/writer.hpp"
+
+namespace qte::nets {
+namespace {
+
+using torch::optim::AdamParamState;
+
+// Weights and buffers of one network, by the names torch gives them.
+std::vector<std::pair<std::string, torch::Tensor>> named_tensors(const QAttentionModule& module) {
+  std::vector<std::pair<std::string, torch::Tensor>> tensors;
+  for (const auto& p : module.named_parameters()) tensors.emplace_back(p.key(), p.value());
+  for (const auto& b : module.named_buffers()) tensors.emplace_back(b.key(), b.value());
+  return tensors;
+}
+
+std::string depth_prefix(int depth) { return "depth" + std::to_string(depth) + "."; }
+
+// Adam keys its per-parameter state by the parameter's TensorImpl (as torch/optim/serialize.h).
+std::string adam_key(const torch::Tensor& parameter) { return c10::guts::to_string(parameter.unsafeGetTensorImpl()); }
+
+stream::Shape shape_of(const torch::Tensor& t) { return stream::Shape(t.sizes().begin(), t.sizes().end()); }
+
+void set_tensor(stream::Record& record, const std::string& name, const torch::Tensor& tensor) {
+  const auto values = tensor.detach().to(torch::kFloat32).contiguous();
+  record.set_raw(name, stream::DType::f32, shape_of(values), values.data_ptr<float>());
+}
+
+std::string config_json(const CheckpointConfig& c) {
+  return std::string("{\"architecture\": \"") + architecture_name(c.net.architecture) +
+         "\", \"base_channels\": " + std::to_string(c.net.base_channels) +
+         ", \"voxels\": " + std::to_string(c.net.voxels) + ", \"channels\": " + std::to_string(c.net.channels) +
+         ", \"proprio\": " + std::to_string(c.net.proprio) + ", \"depths\": " + std::to_string(c.depths) + "}";
+}
+
+// The config every network of the stack shares; refuses stacks that are not one per depth.
+CheckpointConfig stack_config(const std::vector<QAttentionNet>& nets) {
+  if (nets.empty()) throw Error("checkpoint: no networks");
+  CheckpointConfig config{nets.front().config(), static_cast<int>(nets.size()), 0};
+  for (std::size_t d = 0; d < nets.size(); ++d) {
+    const NetConfig& c = nets[d].config();
+    const bool same = c.architecture == config.net.architecture && c.base_channels == config.net.base_channels &&
+                      c.voxels == config.net.voxels && c.channels == config.net.channels &&
+                      c.proprio == config.net.proprio;
+    if (!same || c.depth != static_cast<int>(d) || c.is_last != (d + 1 == nets.size()))
+      throw Error("checkpoint: network " + std::to_string(d) + " is not depth " + std::to_string(d) +
+                  " of the same stack (one network per depth, same settings, the last one is_last)");
+  }
+  return config;
+}
+
+// `depth<digit>...` and `adam....`: the names of tensors, as opposed to config fields.
+bool is_tensor_name(const std::string& name) {
+  const bool depth_tensor =
+      name.rfind("depth", 0) == 0 && name.size() > 5 && std::isdigit(static_cast<unsigned char>(name[5]));
+  return depth_tensor || name.rfind("adam.", 0) == 0;
+}
+
+// One tensor to load: where it comes from and where it goes.
+struct PendingCopy {
+  const stream::Field* field;
+  torch::Tensor destination;
+};
+
+}  // namespace
+
+stream::Record checkpoint_record(const std::vector<QAttentionNet>& nets, const torch::optim::Adam* adam, int64_t step) {
+  CheckpointConfig config = stack_config(nets);
+  stream::Record record("checkpoint");
+  record.set_string("architecture", architecture_name(config.net.architecture));
+  record.set_scalar<int64_t>("base_channels", config.net.base_channels);
+  record.set_scalar<int64_t>("voxels", config.net.voxels);
+  record.set_scalar<int64_t>("channels", config.net.channels);
+  record.set_scalar<int64_t>("proprio", config.net.proprio);
+  record.set_scalar<int64_t>("depths", config.depths);
+  record.set_scalar<int64_t>("step", step);
+  record.set_string("config", config_json(config));
+  for (const auto& net : nets)
+    for (const auto& [name, tensor] : named_tensors(net.module()))
+      set_tensor(record, depth_prefix(net.config().depth) + name, tensor);
+  if (adam == nullptr) return record;
+  for (const auto& net : nets) {
+    for (const auto& p : net.module().named_parameters()) {
+      const auto found = adam->state().find(adam_key(p.value()));
+      if (found == adam->state().end()) continue;  // never stepped: no state yet
+      const auto& state = static_cast<const AdamParamState&>(*found->second);
+      const std::string name = "adam." + depth_prefix(net.config().depth) + p.key();
+      set_tensor(record, name + ".exp_avg", state.exp_avg());
+      set_tensor(record, name + ".exp_avg_sq", state.exp_avg_sq());
+      if (state.max_exp_avg_sq().defined()) set_tensor(record, name + ".max_exp_avg_sq", state.max_exp_avg_sq());
+      record.set_scalar<int64_t>(name + ".step", state.step());
+    }
+  }
+  return record;
+}
+
+void save_checkpoint(const std::string& path, const std::vector<QAttentionNet>& nets, const torch::optim::Adam* adam,
+                     int64_t step) {
+  const stream::Record record = checkpoint_record(nets, adam, step);
+  stream::RecordWriter writer(path, {stream::WriteMode::replace});
+  writer.write(record);
+  writer.close();
+}
+
+CheckpointConfig checkpoint_config(const stream::Record& record) {
+  if (record.type() != "checkpoint")
+    throw StreamError(record.position, "expected a 'checkpoint' record, got '" + record.type() + "'");
+  const auto integer = [&](const char* name) { return static_cast<int>(record.scalar<int64_t>(name)); };
+  CheckpointConfig config;
+  const std::string architecture = record.string("architecture");
+  if (architecture != "arm" && architecture != "light")
+    throw StreamError(record.position, "'checkpoint' record: unknown architecture '" + architecture + "'");
+  config.net.architecture = architecture_from_name(architecture);
+  config.net.base_channels = integer("base_channels");
+  config.net.voxels = integer("voxels");
+  config.net.channels = integer("channels");
+  config.net.proprio = integer("proprio");
+  config.depths = integer("depths");
+  config.net.is_last = config.depths == 1;
+  config.step = record.scalar<int64_t>("step");
+  return config;
+}
+
+namespace {
+
+stream::Record read_first_record(const std::string& path) {
+  stream::RecordReader reader(path);
+  std::optional<stream::Record> record = reader.next();
+  if (!record) throw StreamError({path, 0, 0}, "expected a 'checkpoint' record, the file is empty");
+  return std::move(*record);
+}
+
+}  // namespace
+
+CheckpointConfig read_checkpoint_config(const std::string& path) { return checkpoint_config(read_first_record(path)); }
+
+int64_t load_checkpoint_record(const stream::Record& record, std::vector<QAttentionNet>& nets,
+                               torch::optim::Adam* adam) {
+  const CheckpointConfig want = stack_config(nets);
+  const CheckpointConfig have = checkpoint_config(record);
+  const auto refuse = [&](const std::string& what) {
+    throw Error(record.position.describe() + ": 'checkpoint' record: " + what);
+  };
+  const auto compare = [&](const char* name, const std::string& in_file, const std::string& in_nets) {
+    if (in_file != in_nets) refuse(std::string(name) + " is " + in_file + ", the networks have " + in_nets);
+  };
+  compare("architecture", architecture_name(have.net.architecture), architecture_name(want.net.architecture));
+  compare("base_channels", std::to_string(have.net.base_channels), std::to_string(want.net.base_channels));
+  compare("voxels", std::to_string(have.net.voxels), std::to_string(want.net.voxels));
+  compare("channels", std::to_string(have.net.channels), std::to_string(want.net.channels));
+  compare("proprio", std::to_string(have.net.proprio), std::to_string(want.net.proprio));
+  compare("depths", std::to_string(have.depths), std::to_string(want.depths));
+
+  std::set<std::string> known;  // every field a network or Adam accounts for
+  const auto checked_field = [&](const std::string& name, const torch::Tensor& like) -> const stream::Field& {
+    const stream::Field* field = record.find(name);
+    if (field == nullptr) refuse(name + " is missing");
+    if (field->dtype() != stream::DType::f32)
+      refuse(name + " is " + stream::dtype_name(field->dtype()) + ", the network expects float32");
+    if (field->shape() != shape_of(like))
+      refuse(name + " has shape " + stream::shape_to_string(field->shape()) + ", the network expects " +
+             stream::shape_to_string(shape_of(like)));
+    known.insert(name);
+    return *field;
+  };
+
+  std::vector<PendingCopy> copies;
+  for (auto& net : nets)
+    for (const auto& [name, tensor] : named_tensors(net.module()))
+      copies.push_back({&checked_field(depth_prefix(net.config().depth) + name, tensor), tensor});
+
+  // Adam: per parameter, all of its state or none (a parameter that never had a gradient).
+  std::map<std::string, AdamParamState> adam_states;  // by adam_key
+  std::set<std::string> optimised;
+  if (adam != nullptr)
+    for (const auto& group : adam->param_groups())
+      for (const auto& p : group.params()) optimised.insert(adam_key(p));
+  for (auto& net : nets) {
+    for (const auto& p : net.module().named_parameters()) {
+      const std::string name = "adam." + depth_prefix(net.config().depth) + p.key();
+      if (!record.has(name + ".exp_avg") && !record.has(name + ".exp_avg_sq") && !record.has(name + ".step")) continue;
+      const auto as_tensor = [](const stream::Field& f) {
+        return torch::from_blob(const_cast<uint8_t*>(f.bytes()), f.shape(), torch::kFloat32).clone();
+      };
+      AdamParamState state;
+      state.exp_avg(as_tensor(checked_field(name + ".exp_avg", p.value())));
+      state.exp_avg_sq(as_tensor(checked_field(name + ".exp_avg_sq", p.value())));
+      if (record.has(name + ".max_exp_avg_sq"))
+        state.max_exp_avg_sq(as_tensor(checked_field(name + ".max_exp_avg_sq", p.value())));
+      if (!record.has(name + ".step")) refuse(name + ".step is missing");
+      state.step(record.scalar<int64_t>(name + ".step"));
+      known.insert(name + ".step");
+      if (adam != nullptr && !optimised.count(adam_key(p.value())))
+        throw Error("load_checkpoint: the optimiser does not hold parameter " + depth_prefix(net.config().depth) +
+                    p.key());
+      adam_states.emplace(adam_key(p.value()), std::move(state));
+    }
+  }
+
+  for (const auto& field : record.fields())
+    if (is_tensor_name(field.name()) && !known.count(field.name()))
+      refuse(field.name() + " is not a tensor of the networks");
+
+  torch::NoGradGuard no_grad;
+  for (const auto& copy : copies)
+    copy.destination.copy_(
+        torch::from_blob(const_cast<uint8_t*>(copy.field->bytes()), copy.field->shape(), torch::kFloat32));
+  if (adam != nullptr) {
+    // The optimiser's state for these networks becomes the checkpoint's: restored, or fresh.
+    for (const auto& net : nets) {
+      for (const auto& p : net.module().parameters()) {
+        const std::string key = adam_key(p);
+        const auto state = adam_states.find(key);
+        if (state != adam_states.end())
+          adam->state()[key] = std::make_unique<AdamParamState>(state->second);
+        else
+          adam->state().erase(key);
+      }
+    }
+  }
+  return have.step;
+}
+
+int64_t load_checkpoint(const std::string& path, std::vector<QAttentionNet>& nets, torch::optim::Adam* adam) {
+  return load_checkpoint_record(read_first_record(path), nets, adam);
+}
+
+}  // namespace qte::nets

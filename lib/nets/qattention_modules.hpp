@@ -1,0 +1,55 @@
+// The torch side of the Q-attention networks, for the learning code only (everything else
+// includes nets/qattention_net.hpp, which keeps LibTorch's headers out).
+#pragma once
+
+#include <torch/torch.h>
+
+#include <memory>
+#include <vector>
+
+#include "nets/qattention_net.hpp"
+
+namespace qte::nets {
+
+struct QOutputs {
+  torch::Tensor translation;  // [B, V, V, V]
+  torch::Tensor rotation;     // [B, 3, 72]; undefined unless the config is_last
+  torch::Tensor gripper;      // [B, 2]; undefined unless the config is_last
+};
+
+// One depth's network. Parameter names are those of the architecture's module tree; for
+// `arm` they are exactly those of Net in shared/bench/torch_qattention_ref.py, so Python can
+// load our weights into it by name.
+class QAttentionModule : public torch::nn::Module {
+ public:
+  explicit QAttentionModule(const NetConfig& config) : config_(config) {}
+  const NetConfig& config() const { return config_; }
+
+  // grid: [B, channels, V, V, V] (channels first: see channels_first), proprio: [B, proprio].
+  // A batch of one runs as two copies of the sample: LibTorch 1.13 sends batch-1 3D
+  // convolutions with 3x3x3 kernels to its vol2col fallback rather than oneDNN, which makes
+  // them slower than the same convolutions at batch 2 (measured with PyTorch 1.13 on 2 threads:
+  // light 41 ms at batch 1 against 6 ms at batch 2, arm 368 ms against 77 ms).
+  QOutputs forward(const torch::Tensor& grid, const torch::Tensor& proprio);
+
+  // Multiply-accumulates of one sample's forward pass in convolutions and linear layers
+  // (element-wise work not counted); x2 for FLOPs, about x3 again for forward + backward.
+  virtual int64_t multiply_accumulates() const = 0;
+
+ protected:
+  virtual QOutputs forward_batch(const torch::Tensor& grid, const torch::Tensor& proprio) = 0;
+
+ private:
+  NetConfig config_;
+};
+
+std::shared_ptr<QAttentionModule> make_qattention_module(const NetConfig& config);
+
+// Our grids are channels last, [B, V, V, V, C] (voxels::voxelize); convolutions want
+// [B, C, V, V, V]. Index order x, y, z is kept, so Q volumes come out in our order.
+torch::Tensor channels_first(const torch::Tensor& grids);
+
+// Every parameter of the networks (for an optimiser over all depths).
+std::vector<torch::Tensor> parameters_of(std::vector<QAttentionNet>& nets);
+
+}  // namespace qte::nets

@@ -1,0 +1,81 @@
+#include "nets/qattention_net.hpp"
+
+#include "common/error.hpp"
+#include "nets/qattention_modules.hpp"
+
+namespace qte::nets {
+
+const char* architecture_name(Architecture architecture) { return architecture == Architecture::arm ? "arm" : "light"; }
+
+Architecture architecture_from_name(const std::string& name) {
+  if (name == "arm") return Architecture::arm;
+  if (name == "light") return Architecture::light;
+  throw Error("unknown network architecture '" + name + "' (expected arm or light)");
+}
+
+int default_base_channels(Architecture architecture) { return architecture == Architecture::arm ? 64 : 16; }
+
+void NetConfig::validate() const {
+  const auto refuse = [](const std::string& what) { throw Error("network config: " + what); };
+  if (depth < 0) refuse("depth must be >= 0, got " + std::to_string(depth));
+  if (voxels < 4 || voxels % 4 != 0)
+    refuse("voxels must be a positive multiple of 4 (the U-Net halves the grid twice), got " + std::to_string(voxels));
+  if (channels < 1) refuse("channels must be >= 1, got " + std::to_string(channels));
+  if (proprio < 1) refuse("proprio must be >= 1, got " + std::to_string(proprio));
+  // The arm's inception blocks split their width 1/2 + 1/4 + 1/4.
+  const int multiple = architecture == Architecture::arm ? 4 : 1;
+  if (base_channels < 1 || base_channels % multiple != 0)
+    refuse("base_channels of the " + std::string(architecture_name(architecture)) +
+           " network must be a positive multiple of " + std::to_string(multiple) + ", got " +
+           std::to_string(base_channels));
+}
+
+QAttentionNet::QAttentionNet(const NetConfig& config) : config_(config), module_(make_qattention_module(config)) {}
+QAttentionNet::~QAttentionNet() = default;
+QAttentionNet::QAttentionNet(QAttentionNet&&) noexcept = default;
+QAttentionNet& QAttentionNet::operator=(QAttentionNet&&) noexcept = default;
+
+int64_t QAttentionNet::parameter_count() const {
+  int64_t count = 0;
+  for (const auto& p : module_->parameters()) count += p.numel();
+  return count;
+}
+
+QValues QAttentionNet::predict(const float* grids, const float* proprio, int batch) const {
+  const int64_t v = config_.voxels;
+  torch::NoGradGuard no_grad;
+  // from_blob does not copy; channels_first makes the one copy the convolutions need.
+  const auto grid = torch::from_blob(const_cast<float*>(grids), {batch, v, v, v, config_.channels});
+  const auto state = torch::from_blob(const_cast<float*>(proprio), {batch, config_.proprio});
+  const QOutputs out = module_->forward(channels_first(grid), state);
+  const auto to_vector = [](const torch::Tensor& t) {
+    const auto c = t.contiguous();
+    return std::vector<float>(c.data_ptr<float>(), c.data_ptr<float>() + c.numel());
+  };
+  QValues values;
+  values.batch = batch;
+  values.translation = to_vector(out.translation);
+  if (out.rotation.defined()) values.rotation = to_vector(out.rotation);
+  if (out.gripper.defined()) values.gripper = to_vector(out.gripper);
+  return values;
+}
+
+std::vector<QAttentionNet> make_coarse_to_fine_nets(NetConfig config, int depths) {
+  if (depths < 1) throw Error("network config: depths must be >= 1, got " + std::to_string(depths));
+  std::vector<QAttentionNet> nets;
+  for (int d = 0; d < depths; ++d) {
+    config.depth = d;
+    config.is_last = d == depths - 1;
+    nets.emplace_back(config);
+  }
+  return nets;
+}
+
+void seed_torch(uint64_t seed) { torch::manual_seed(seed); }
+
+void set_torch_threads(int threads) {
+  if (threads < 1) throw Error("torch threads must be >= 1, got " + std::to_string(threads));
+  torch::set_num_threads(threads);
+}
+
+}  // namespace qte::nets

@@ -1,0 +1,86 @@
+// The Q-attention network of one coarse-to-fine depth (C2F-ARM): a 3D U-Net over a voxel grid
+// with proprioception tiled over the voxels, giving a Q value per voxel; the last depth also
+// gives rotation and gripper Q values from a dense head on pooled U-Net features.
+//
+// This header is free of LibTorch so that code which only runs networks compiles fast; the
+// learning code reaches the torch module through nets/qattention_modules.hpp.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace qte::nets {
+
+enum class Architecture {
+  arm,    // the published inception-style U-Net (64 base channels): ~1.8 GMAC per sample
+  light,  // the CPU default: plain 3x3x3 convolutions, two downsamplings, 16 base channels
+};
+
+const char* architecture_name(Architecture architecture);      // "arm", "light"
+Architecture architecture_from_name(const std::string& name);  // throws Error
+int default_base_channels(Architecture architecture);          // arm 64, light 16
+
+// Rotation Q values: 3 Euler axes x 72 bins of 5 degrees; gripper: open / close.
+constexpr int kRotationAxes = 3;
+constexpr int kRotationBins = 72;
+constexpr int kGripperActions = 2;
+
+struct NetConfig {
+  int depth = 0;         // coarse-to-fine depth this network serves (0 = scene bounds)
+  bool is_last = false;  // the last depth also outputs rotation and gripper Q values
+  int voxels = 16;       // grid of voxels^3 (a multiple of 4: the U-Net halves it twice)
+  int channels = 10;     // per-voxel channels (voxels::kChannels)
+  // Proprioception: gripper open, the two finger positions (opening / 2 each), time in
+  // [-1, 1]. The reference script uses 11.
+  int proprio = 4;
+  Architecture architecture = Architecture::light;
+  int base_channels = 16;  // kernels of the first U-Net level (default_base_channels())
+
+  // Throws Error naming the first setting a network cannot be built with.
+  void validate() const;
+};
+
+// Outputs of a batch, as plain arrays (C order).
+struct QValues {
+  int batch = 0;
+  std::vector<float> translation;  // [batch, voxels, voxels, voxels], index order x, y, z
+  std::vector<float> rotation;     // [batch, 3, 72] (last depth only, otherwise empty)
+  std::vector<float> gripper;      // [batch, 2] (last depth only, otherwise empty)
+};
+
+class QAttentionModule;  // the torch module (nets/qattention_modules.hpp)
+
+class QAttentionNet {
+ public:
+  // Fresh weights drawn from torch's generator: call seed_torch() first to reproduce them.
+  explicit QAttentionNet(const NetConfig& config);
+  ~QAttentionNet();
+  QAttentionNet(QAttentionNet&&) noexcept;
+  QAttentionNet& operator=(QAttentionNet&&) noexcept;
+
+  const NetConfig& config() const { return config_; }
+  int64_t parameter_count() const;
+
+  // Inference without gradients. `grids`: [batch, voxels, voxels, voxels, channels], channels
+  // last as voxels::voxelize writes them; `proprio`: [batch, proprio].
+  QValues predict(const float* grids, const float* proprio, int batch) const;
+
+  QAttentionModule& module() { return *module_; }
+  const QAttentionModule& module() const { return *module_; }
+
+ private:
+  NetConfig config_;
+  std::shared_ptr<QAttentionModule> module_;
+};
+
+// One network per depth, depth 0 first, the last marked is_last.
+std::vector<QAttentionNet> make_coarse_to_fine_nets(NetConfig config, int depths);
+
+// Seeds torch's CPU generator: the same seed gives the same initial weights.
+void seed_torch(uint64_t seed);
+// Intra-op threads of LibTorch (its default is every core).
+void set_torch_threads(int threads);
+
+}  // namespace qte::nets

@@ -1,0 +1,341 @@
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "common/error.hpp"
+#include "nets/checkpoint.hpp"
+#include "nets/qattention_modules.hpp"
+#include "stream/writer.hpp"
+
+namespace qte::nets {
+namespace {
+
+constexpr int V = 16;
+constexpr int C = 10;
+
+NetConfig config_of(Architecture architecture, int base_channels, int proprio = 4) {
+  NetConfig config;
+  config.architecture = architecture;
+  config.base_channels = base_channels;
+  config.proprio = proprio;
+  return config;
+}
+
+std::string temp_path(const std::string& name) {
+  return ::testing::TempDir() + "nets_" + std::to_string(::getpid()) + "_" + name;
+}
+
+std::string file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+void write_file(const std::string& path, const std::string& bytes) { std::ofstream(path, std::ios::binary) << bytes; }
+
+void write_record(const std::string& path, const stream::Record& record) {
+  stream::RecordWriter writer(path);
+  writer.write(record);
+  writer.close();
+}
+
+// Runs `load` and returns the message of the Error it must throw (failing if it is a
+// StreamError: a mismatch is not damage).
+template <class Load>
+std::string mismatch_message(Load load) {
+  try {
+    load();
+  } catch (const StreamError& e) {
+    ADD_FAILURE() << "expected a mismatch Error, got StreamError: " << e.what();
+    return e.what();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no error thrown";
+  return "";
+}
+
+// One channels-last grid as voxels::voxelize writes it: index channels everywhere, a cube of
+// occupied voxels (mean position, grey colour, occupancy) of half-size `radius` at `centre`.
+void fill_grid(float* grid, int cx, int cy, int cz, int radius) {
+  for (int x = 0; x < V; ++x)
+    for (int y = 0; y < V; ++y)
+      for (int z = 0; z < V; ++z) {
+        float* voxel = grid + ((x * V + y) * V + z) * C;
+        const bool occupied = std::abs(x - cx) <= radius && std::abs(y - cy) <= radius && std::abs(z - cz) <= radius;
+        for (int c = 0; c < C; ++c) voxel[c] = 0;
+        if (occupied) {
+          voxel[0] = (x + 0.5f) / V, voxel[1] = (y + 0.5f) / V, voxel[2] = (z + 0.5f) / V;
+          voxel[3] = voxel[4] = voxel[5] = 0.2f;
+          voxel[9] = 1;
+        }
+        voxel[6] = float(x) / V, voxel[7] = float(y) / V, voxel[8] = float(z) / V;
+      }
+}
+
+TEST(QAttentionNet, ChannelsFirstKeepsTheVoxelIndexOrder) {
+  auto grid = torch::zeros({1, V, V, V, C});
+  grid[0][3][5][7][9] = 1;
+  const auto first = channels_first(grid);
+  EXPECT_EQ(first.sizes(), (torch::IntArrayRef{1, C, V, V, V}));
+  EXPECT_EQ(first[0][9][3][5][7].item<float>(), 1);
+  EXPECT_EQ(first.sum().item<float>(), 1);
+}
+
+TEST(QAttentionNet, OutputShapesForBothArchitecturesAndDepths) {
+  seed_torch(1);
+  const int batch = 2;
+  std::vector<float> grids(batch * V * V * V * C, 0.1f), proprio(batch * 4, 0.5f);
+  for (Architecture architecture : {Architecture::arm, Architecture::light}) {
+    auto nets = make_coarse_to_fine_nets(config_of(architecture, default_base_channels(architecture)), 2);
+    for (const auto& net : nets) {
+      SCOPED_TRACE(std::string(architecture_name(architecture)) + " depth " + std::to_string(net.config().depth));
+      const QValues q = net.predict(grids.data(), proprio.data(), batch);
+      EXPECT_EQ(q.translation.size(), std::size_t(batch * V * V * V));
+      const std::size_t rotations = net.config().is_last ? batch * kRotationAxes * kRotationBins : 0;
+      const std::size_t grippers = net.config().is_last ? batch * kGripperActions : 0;
+      EXPECT_EQ(q.rotation.size(), rotations);
+      EXPECT_EQ(q.gripper.size(), grippers);
+      for (float value : q.translation) ASSERT_TRUE(std::isfinite(value));
+    }
+    // The torch view of the last depth, with the shapes the learner indexes.
+    auto& module = nets.back().module();
+    const QOutputs out = module.forward(torch::randn({batch, C, V, V, V}), torch::randn({batch, 4}));
+    EXPECT_EQ(out.translation.sizes(), (torch::IntArrayRef{batch, V, V, V}));
+    EXPECT_EQ(out.rotation.sizes(), (torch::IntArrayRef{batch, 3, 72}));
+    EXPECT_EQ(out.gripper.sizes(), (torch::IntArrayRef{batch, 2}));
+    EXPECT_FALSE(nets.front().module().forward(torch::randn({1, C, V, V, V}), torch::randn({1, 4})).rotation.defined());
+  }
+}
+
+// Numbers printed by the reference, shared/bench/torch_qattention_ref.py, whose Net takes 11
+// proprio inputs and 10 channels at 64 base kernels:
+//   /usr/bin/python3 -c "import sys; sys.argv = ['x']; exec(open('torch_qattention_ref.py')
+//     .read().split('if __name__')[0]); print([sum(p.numel() for p in Net(d).parameters())
+//     for d in (False, True)])"
+// gives [879553, 1186459]. Parameter names also match the reference's (so Python can load our
+// weights into its Net by name): checked here for a few of them.
+TEST(QAttentionNet, ArmParameterCountsEqualTheReference) {
+  EXPECT_EQ(QAttentionNet(config_of(Architecture::arm, 64, 11)).parameter_count(), 879553);
+  NetConfig last = config_of(Architecture::arm, 64, 11);
+  last.is_last = true;
+  QAttentionNet net(last);
+  EXPECT_EQ(net.parameter_count(), 1186459);
+  // With our 4 proprio inputs, the proprio layer has 7 x 64 weights fewer.
+  EXPECT_EQ(QAttentionNet(config_of(Architecture::arm, 64, 4)).parameter_count(), 879553 - 7 * 64);
+  const auto named = net.module().named_parameters();
+  for (const char* name : {"inp.a.0.weight", "inp.c.4.bias", "prop.weight", "u2.p.b.2.weight", "u1.q.c.0.weight",
+                           "f2.weight", "h.0.weight", "h.4.bias"})
+    EXPECT_TRUE(named.contains(name)) << name;
+  EXPECT_EQ(named["h.0.weight"].sizes(), (torch::IntArrayRef{128, 2048}));
+  EXPECT_EQ(named["h.4.weight"].sizes(), (torch::IntArrayRef{218, 128}));
+}
+
+TEST(QAttentionNet, RefusesConfigsItCannotBuild) {
+  NetConfig config;
+  config.voxels = 10;
+  EXPECT_THROW(QAttentionNet{config}, Error);
+  config = config_of(Architecture::arm, 30);
+  EXPECT_THROW(QAttentionNet{config}, Error);
+  EXPECT_THROW(architecture_from_name("resnet"), Error);
+}
+
+// A real learning check: two scenes with a block at different places; the target voxel is the
+// block's centre. After a few dozen Adam steps the argmax of each Q volume is its target.
+TEST(QAttentionNet, LightLearnsToPointAtTheBlock) {
+  seed_torch(3);
+  QAttentionNet net(config_of(Architecture::light, 16));
+  const int targets[2][3] = {{4, 11, 6}, {12, 3, 9}};
+  auto grids = torch::zeros({2, V, V, V, C});
+  for (int b = 0; b < 2; ++b) fill_grid(grids[b].data_ptr<float>(), targets[b][0], targets[b][1], targets[b][2], 1);
+  const auto input = channels_first(grids);
+  const auto proprio = torch::zeros({2, 4});
+  const auto target_index = torch::tensor({(targets[0][0] * V + targets[0][1]) * V + targets[0][2],
+                                           (targets[1][0] * V + targets[1][1]) * V + targets[1][2]});
+  torch::optim::Adam adam(net.module().parameters(), torch::optim::AdamOptions(3e-3));
+  const auto loss_now = [&] {
+    return torch::nn::functional::cross_entropy(net.module().forward(input, proprio).translation.flatten(1),
+                                                target_index);
+  };
+  const float first_loss = loss_now().item<float>();
+  for (int step = 0; step < 60; ++step) {
+    adam.zero_grad();
+    auto loss = loss_now();
+    loss.backward();
+    adam.step();
+  }
+  torch::NoGradGuard no_grad;
+  const auto chosen = net.module().forward(input, proprio).translation.flatten(1).argmax(1);
+  EXPECT_TRUE(torch::equal(chosen, target_index)) << "chose " << chosen << " want " << target_index;
+  EXPECT_LT(loss_now().item<float>(), 0.5f * first_loss);
+}
+
+TEST(Checkpoint, RoundTripGivesIdenticalOutputs) {
+  const std::string path = temp_path("round_trip.rec");
+  seed_torch(11);
+  auto saved = make_coarse_to_fine_nets(config_of(Architecture::light, 8), 2);
+  save_checkpoint(path, saved, nullptr, 1234);
+  seed_torch(12);
+  auto loaded = make_coarse_to_fine_nets(config_of(Architecture::light, 8), 2);
+  EXPECT_EQ(load_checkpoint(path, loaded), 1234);
+
+  const CheckpointConfig config = read_checkpoint_config(path);
+  EXPECT_EQ(config.net.architecture, Architecture::light);
+  EXPECT_EQ(config.net.base_channels, 8);
+  EXPECT_EQ(config.depths, 2);
+  EXPECT_EQ(config.step, 1234);
+
+  const auto grids = torch::rand({3, V, V, V, C});
+  const auto proprio = torch::rand({3, 4});
+  for (int d = 0; d < 2; ++d) {
+    const QValues a = saved[d].predict(grids.data_ptr<float>(), proprio.data_ptr<float>(), 3);
+    const QValues b = loaded[d].predict(grids.data_ptr<float>(), proprio.data_ptr<float>(), 3);
+    EXPECT_EQ(a.translation, b.translation);
+    EXPECT_EQ(a.rotation, b.rotation);
+    EXPECT_EQ(a.gripper, b.gripper);
+  }
+  std::remove(path.c_str());
+}
+
+TEST(Checkpoint, SameSeedGivesIdenticalBytes) {
+  const auto save_seeded = [](uint64_t seed, const std::string& name) {
+    seed_torch(seed);
+    const auto nets = make_coarse_to_fine_nets(config_of(Architecture::light, 8), 2);
+    const std::string path = temp_path(name);
+    save_checkpoint(path, nets, nullptr, 0);
+    const std::string bytes = file_bytes(path);
+    std::remove(path.c_str());
+    return bytes;
+  };
+  const std::string a = save_seeded(5, "a.rec"), b = save_seeded(5, "b.rec"), c = save_seeded(6, "c.rec");
+  EXPECT_GT(a.size(), 100000u);
+  EXPECT_TRUE(a == b);
+  EXPECT_FALSE(a == c);
+}
+
+TEST(Checkpoint, AdamStateRoundTripContinuesTrainingIdentically) {
+  const auto train_step = [](std::vector<QAttentionNet>& nets, torch::optim::Adam& adam) {
+    torch::manual_seed(99);  // the same batch for both copies
+    const auto grids = torch::rand({2, C, V, V, V});
+    const auto proprio = torch::rand({2, 4});
+    adam.zero_grad();
+    torch::Tensor loss = torch::zeros({});
+    for (auto& net : nets) {
+      const QOutputs out = net.module().forward(grids, proprio);
+      loss = loss + out.translation.square().mean();
+      if (out.rotation.defined()) loss = loss + out.rotation.square().mean() + out.gripper.square().mean();
+    }
+    loss.backward();
+    adam.step();
+  };
+  const std::string path = temp_path("adam.rec");
+  seed_torch(21);
+  auto nets = make_coarse_to_fine_nets(config_of(Architecture::light, 8), 2);
+  torch::optim::Adam adam(parameters_of(nets), torch::optim::AdamOptions(1e-3));
+  train_step(nets, adam);
+  train_step(nets, adam);
+  save_checkpoint(path, nets, &adam, 2);
+
+  seed_torch(22);
+  auto resumed = make_coarse_to_fine_nets(config_of(Architecture::light, 8), 2);
+  torch::optim::Adam resumed_adam(parameters_of(resumed), torch::optim::AdamOptions(1e-3));
+  EXPECT_EQ(load_checkpoint(path, resumed, &resumed_adam), 2);
+  EXPECT_EQ(resumed_adam.state().size(), adam.state().size());
+
+  train_step(nets, adam);
+  train_step(resumed, resumed_adam);
+  const auto a = parameters_of(nets), b = parameters_of(resumed);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(torch::equal(a[i], b[i])) << "parameter " << i;
+
+  // A weights-only load leaves the optimiser fresh.
+  save_checkpoint(path, nets, nullptr, 3);
+  load_checkpoint(path, resumed, &resumed_adam);
+  EXPECT_EQ(resumed_adam.state().size(), 0u);
+  std::remove(path.c_str());
+}
+
+TEST(Checkpoint, LoadErrorsNameTheField) {
+  const std::string path = temp_path("errors.rec");
+  seed_torch(31);
+  auto nets = make_coarse_to_fine_nets(config_of(Architecture::light, 8), 2);
+  const stream::Record good = checkpoint_record(nets, nullptr, 0);
+
+  stream::Record wrong_shape = good;
+  wrong_shape.set("depth1.head.4.weight", {218, 64}, std::vector<float>(218 * 64, 0.0f));
+  write_record(path, wrong_shape);
+  EXPECT_EQ(mismatch_message([&] { load_checkpoint(path, nets); }),
+            path +
+                ": record 0 at byte 0: 'checkpoint' record: depth1.head.4.weight has shape [218, 64], "
+                "the network expects [218, 128]");
+
+  stream::Record missing = good;
+  missing.remove("depth0.up0.bias");
+  write_record(path, missing);
+  EXPECT_NE(mismatch_message([&] { load_checkpoint(path, nets); }).find("depth0.up0.bias is missing"),
+            std::string::npos);
+
+  stream::Record extra = good;
+  extra.set("depth0.spare.weight", {2}, std::vector<float>{1, 2});
+  write_record(path, extra);
+  EXPECT_NE(mismatch_message([&] { load_checkpoint(path, nets); }).find("depth0.spare.weight is not a tensor"),
+            std::string::npos);
+
+  stream::Record wrong_dtype = good;
+  wrong_dtype.set("depth0.q.bias", {1}, std::vector<double>{0.0});
+  write_record(path, wrong_dtype);
+  EXPECT_NE(mismatch_message([&] { load_checkpoint(path, nets); }).find("depth0.q.bias is float64"), std::string::npos);
+
+  seed_torch(32);
+  save_checkpoint(path, make_coarse_to_fine_nets(config_of(Architecture::arm, 8), 2), nullptr, 0);
+  EXPECT_NE(mismatch_message([&] { load_checkpoint(path, nets); }).find("architecture is arm, the networks have light"),
+            std::string::npos);
+
+  save_checkpoint(path, make_coarse_to_fine_nets(config_of(Architecture::light, 8), 3), nullptr, 0);
+  EXPECT_NE(mismatch_message([&] { load_checkpoint(path, nets); }).find("depths is 3, the networks have 2"),
+            std::string::npos);
+
+  save_checkpoint(path, make_coarse_to_fine_nets(config_of(Architecture::light, 8, 11), 2), nullptr, 0);
+  EXPECT_NE(mismatch_message([&] { load_checkpoint(path, nets); }).find("proprio is 11, the networks have 4"),
+            std::string::npos);
+
+  // A failed load leaves the networks as they were.
+  const auto before = parameters_of(nets)[0].clone();
+  write_record(path, wrong_shape);
+  EXPECT_THROW(load_checkpoint(path, nets), Error);
+  EXPECT_TRUE(torch::equal(before, parameters_of(nets)[0]));
+  std::remove(path.c_str());
+}
+
+TEST(Checkpoint, DamagedFileGivesStreamError) {
+  const std::string path = temp_path("damaged.rec");
+  seed_torch(41);
+  auto nets = make_coarse_to_fine_nets(config_of(Architecture::light, 8), 2);
+  save_checkpoint(path, nets, nullptr, 0);
+  const std::string bytes = file_bytes(path);
+
+  std::string flipped = bytes;
+  flipped[flipped.size() / 2] ^= 0x10;
+  write_file(path, flipped);
+  EXPECT_THROW(load_checkpoint(path, nets), StreamError);
+
+  write_file(path, bytes.substr(0, bytes.size() - 100));
+  EXPECT_THROW(load_checkpoint(path, nets), StreamError);
+
+  write_file(path, "");
+  EXPECT_THROW(load_checkpoint(path, nets), StreamError);
+
+  write_record(path, stream::Record("metrics"));
+  EXPECT_THROW(load_checkpoint(path, nets), StreamError);
+
+  write_file(path, bytes);
+  EXPECT_NO_THROW(load_checkpoint(path, nets));
+  std::remove(path.c_str());
+}
+
+}  // namespace
+}  // namespace qte::nets
