@@ -1,0 +1,114 @@
+#include "qattention/tree_expansion.hpp"
+
+#include <algorithm>
+#include <numeric>
+
+#include "common/error.hpp"
+
+namespace qte::qattention {
+
+std::vector<int> top_k(const float* q, int count, int k) {
+  std::vector<int> order(count);
+  std::iota(order.begin(), order.end(), 0);
+  k = std::min(k, count);
+  std::partial_sort(order.begin(), order.begin() + k, order.end(),
+                    [&](int a, int b) { return q[a] > q[b] || (q[a] == q[b] && a < b); });
+  order.resize(k);
+  return order;
+}
+
+namespace {
+
+Eigen::Vector3i unflatten(int flat, int v) { return Eigen::Vector3i(flat / (v * v), (flat / v) % v, flat % v); }
+
+int argmax(const float* q, int count) { return top_k(q, count, 1)[0]; }
+
+}  // namespace
+
+Choice expand(const DepthEvaluator& evaluate, const voxels::CoarseToFine& hierarchy,
+              const voxels::PointCloud& cloud, const std::vector<float>& proprio, int k) {
+  if (k < 1) throw Error("tree expansion needs k >= 1");
+  const int depths = hierarchy.depths, v = hierarchy.voxels(), cells = v * v * v;
+  const std::size_t grid_floats = static_cast<std::size_t>(cells) * voxels::kChannels;
+
+  // Level by level, every node of the tree: its grid, its parent and the voxel of the parent
+  // it expands, and (filled after the forward) its Q volume.
+  struct Node {
+    voxels::GridBounds bounds;
+    int parent = -1;
+    int parent_voxel = -1;
+  };
+  std::vector<std::vector<Node>> levels(depths);
+  std::vector<nets::QValues> outputs(depths);
+  levels[0].push_back({hierarchy.scene, -1, -1});
+  Choice choice;
+  for (int d = 0; d < depths; ++d) {
+    std::vector<voxels::GridBounds> grids;
+    for (const Node& node : levels[d]) grids.push_back(node.bounds);
+    std::vector<float> batch(grid_floats * grids.size());
+    voxels::voxelize_many(cloud, grids, batch.data());
+    const int n = static_cast<int>(grids.size());
+    std::vector<float> proprio_batch;
+    for (int i = 0; i < n; ++i) proprio_batch.insert(proprio_batch.end(), proprio.begin(), proprio.end());
+    outputs[d] = evaluate(d, batch.data(), proprio_batch.data(), n);
+    if (static_cast<int>(outputs[d].translation.size()) != n * cells)
+      throw Error("tree expansion: depth " + std::to_string(d) + " returned the wrong number of Q values");
+    choice.expanded_grids += n;
+    if (d + 1 == depths) break;
+    for (int i = 0; i < n; ++i)
+      for (int flat : top_k(outputs[d].translation.data() + static_cast<std::size_t>(i) * cells, cells, k))
+        levels[d + 1].push_back(
+            {hierarchy.bounds_at(d + 1, levels[d][i].bounds.centre_of(unflatten(flat, v))), i, flat});
+  }
+
+  // Values bottom-up: a leaf is worth its max Q; a node's value through child c is
+  // (q of c's voxel + c's value) / 2, and the node is worth its best child.
+  std::vector<std::vector<float>> value(depths);
+  std::vector<std::vector<int>> best_child(depths);
+  const int leaf = depths - 1;
+  for (std::size_t i = 0; i < levels[leaf].size(); ++i) {
+    const float* q = outputs[leaf].translation.data() + i * cells;
+    value[leaf].push_back(q[argmax(q, cells)]);
+  }
+  for (int d = leaf - 1; d >= 0; --d) {
+    value[d].assign(levels[d].size(), -1e30f);
+    best_child[d].assign(levels[d].size(), -1);
+    for (std::size_t c = 0; c < levels[d + 1].size(); ++c) {
+      const Node& child = levels[d + 1][c];
+      const float q = outputs[d].translation[static_cast<std::size_t>(child.parent) * cells + child.parent_voxel];
+      const float through = (q + value[d + 1][c]) / 2;
+      if (through > value[d][child.parent]) {  // strict: the earlier (higher-ranked) child wins ties
+        value[d][child.parent] = through;
+        best_child[d][child.parent] = static_cast<int>(c);
+      }
+    }
+  }
+  // Follow the best path from the root.
+  int node = 0;
+  choice.value = value[0][0];
+  for (int d = 0; d < depths; ++d) {
+    const float* q = outputs[d].translation.data() + static_cast<std::size_t>(node) * cells;
+    const int voxel = d + 1 < depths ? levels[d + 1][best_child[d][node]].parent_voxel : argmax(q, cells);
+    choice.indices.push_back(unflatten(voxel, v));
+    choice.bounds.push_back(levels[d][node].bounds);
+    choice.q_values.push_back(q[voxel]);
+    if (d + 1 < depths) node = best_child[d][node];
+  }
+  const nets::QValues& last = outputs[leaf];
+  if (!last.rotation.empty()) {
+    const float* r = last.rotation.data() + static_cast<std::size_t>(node) * nets::kRotationAxes * nets::kRotationBins;
+    for (int axis = 0; axis < nets::kRotationAxes; ++axis)
+      choice.rotation_bins[axis] = argmax(r + axis * nets::kRotationBins, nets::kRotationBins);
+    const float* g = last.gripper.data() + static_cast<std::size_t>(node) * nets::kGripperActions;
+    choice.gripper_open = g[1] > g[0];  // index 1 = open, as the transitions' gripper_open
+  }
+  return choice;
+}
+
+DepthEvaluator network_evaluator(const std::vector<nets::QAttentionNet>& nets) {
+  return [&nets](int depth, const float* grids, const float* proprio, int batch) {
+    return nets.at(depth).predict(grids, proprio, batch);
+  };
+}
+
+}  // namespace qte::qattention
