@@ -36,10 +36,6 @@ static cli::Usage usage() {
   return u;
 }
 
-static bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 static void run(const cli::Arguments& args) {
   std::vector<std::string> files = args.positional();
   if (files.empty()) files.push_back("-");
@@ -57,11 +53,11 @@ static void run(const cli::Arguments& args) {
       for (const auto& field : record->fields()) {
         const auto& shape = field.shape();
         const std::string path = dir + "/" + index + "." + field.name() + ".png";
-        if (ends_with(field.name(), ".rgb") && field.dtype() == stream::DType::u8 && shape.size() == 3 && shape[2] == 3) {
+        if (stream::ends_with(field.name(), ".rgb") && field.dtype() == stream::DType::u8 && shape.size() == 3 && shape[2] == 3) {
           const cv::Mat rgb(static_cast<int>(shape[0]), static_cast<int>(shape[1]), CV_8UC3,
                             const_cast<uint8_t*>(field.bytes()));
           render::save_rgb_png(path, rgb);
-        } else if (args.flag("depth") && ends_with(field.name(), ".depth") &&
+        } else if (args.flag("depth") && stream::ends_with(field.name(), ".depth") &&
                    field.dtype() == stream::DType::f32 && shape.size() == 2) {
           const cv::Mat depth(static_cast<int>(shape[0]), static_cast<int>(shape[1]), CV_32FC1,
                               const_cast<uint8_t*>(field.bytes()));

@@ -9,10 +9,6 @@
 namespace qte::keyframes {
 namespace {
 
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() > suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 // FNV-1a: a stable 64-bit key for an episode from what identifies it.
 uint64_t fnv1a(const void* data, std::size_t n, uint64_t h = 1469598103934665603ull) {
   const auto* p = static_cast<const uint8_t*>(data);
@@ -50,16 +46,16 @@ stream::Record frame_record(const stream::Record& obs, int64_t episode_key) {
   frame.set_scalar<int32_t>("frame", obs.scalar<int32_t>("frame"));
   for (const auto& field : obs.fields()) {
     const std::string& name = field.name();
-    if (ends_with(name, ".rgb")) {
+    if (stream::ends_with(name, ".rgb")) {
       frame.set_raw(name, field.dtype(), field.shape(), field.bytes(), /*compress=*/true);
-    } else if (ends_with(name, ".depth")) {
+    } else if (stream::ends_with(name, ".depth")) {
       // Millimetres in 16 bits: 0.5 mm rounding, far below a 1.9 cm voxel, half the bytes.
       const auto depth = obs.array<float>(name);
       std::vector<uint16_t> mm(static_cast<std::size_t>(depth.size()));
       for (std::size_t i = 0; i < mm.size(); ++i)
         mm[i] = static_cast<uint16_t>(std::clamp(std::lround(depth[static_cast<int64_t>(i)] * 1000.0), 0L, 65535L));
       frame.set<uint16_t>(name + "_mm", depth.shape, mm, /*compress=*/true);
-    } else if (ends_with(name, ".intrinsics") || ends_with(name, ".extrinsics")) {
+    } else if (stream::ends_with(name, ".intrinsics") || stream::ends_with(name, ".extrinsics")) {
       frame.add(field);
     }
   }

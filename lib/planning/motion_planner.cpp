@@ -36,18 +36,6 @@ robot::JointVector to_joints(const ob::State* state) {
   return q;
 }
 
-// The camera names of an obs record: every "<name>.points" field with its extrinsics.
-std::vector<std::string> cameras_with_points(const stream::Record& obs) {
-  std::vector<std::string> names;
-  const std::string suffix = ".points";
-  for (const auto& f : obs.fields()) {
-    const std::string& n = f.name();
-    if (n.size() > suffix.size() && n.compare(n.size() - suffix.size(), suffix.size(), suffix) == 0)
-      names.push_back(n.substr(0, n.size() - suffix.size()));
-  }
-  return names;
-}
-
 }  // namespace
 
 StartState start_state_from(const stream::Record& obs) {
@@ -84,7 +72,7 @@ MotionPlanner::MotionPlanner(const robot::RobotModel& robot, const Eigen::Isomet
 }
 
 OccupancyScene MotionPlanner::scene_from(const stream::Record& obs, const StartState& start, const Goal* goal) const {
-  const auto cameras = cameras_with_points(obs);
+  const auto cameras = obs.prefixes(".points");
   if (cameras.empty())
     throw StreamError(obs.position, "'obs' record has no point cloud: plan-path needs <camera>.points "
                                     "(sim-step without --no-points)");

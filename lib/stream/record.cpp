@@ -123,6 +123,17 @@ const Field& Record::typed_field(const std::string& name, DType dtype) const {
   return f;
 }
 
+bool ends_with(const std::string& text, const std::string& suffix) {
+  return text.size() > suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+std::vector<std::string> Record::prefixes(const std::string& suffix) const {
+  std::vector<std::string> out;
+  for (const auto& f : fields_)
+    if (ends_with(f.name(), suffix)) out.push_back(f.name().substr(0, f.name().size() - suffix.size()));
+  return out;
+}
+
 std::string Record::string(const std::string& name) const {
   const Field& f = typed_field(name, DType::str);
   return std::string(reinterpret_cast<const char*>(f.bytes()), f.byte_count());

@@ -107,6 +107,10 @@ class Record {
 
   [[noreturn]] void fail(const std::string& field_name, const std::string& expected) const;
 
+  // The X of every field named X<suffix>, in field order: e.g. the cameras of an observation,
+  // prefixes(".rgb") -> {"front", "wrist"}.
+  std::vector<std::string> prefixes(const std::string& suffix) const;
+
  private:
   const Field& typed_field(const std::string& name, DType dtype) const;
   static void check_count(const std::string& name, const Shape& shape, std::size_t count);
@@ -114,6 +118,8 @@ class Record {
   std::string type_;
   std::vector<Field> fields_;
 };
+
+bool ends_with(const std::string& text, const std::string& suffix);
 
 // Rules for names, shared by reader and writer so both reject the same things.
 bool is_valid_record_type(const std::string& type);  // 1..16 chars of [a-z0-9_]

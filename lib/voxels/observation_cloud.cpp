@@ -30,11 +30,8 @@ void points_from_depth(const float* depth_m, int width, int height, const double
 
 ObservationCloud observation_cloud(const stream::Record& obs) {
   ObservationCloud cloud;
-  const std::string suffix = ".rgb";
-  for (const auto& field : obs.fields()) {
-    const std::string& name = field.name();
-    if (name.size() <= suffix.size() || name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) continue;
-    const std::string camera = name.substr(0, name.size() - suffix.size());
+  for (const std::string& camera : obs.prefixes(".rgb")) {
+    const std::string name = camera + ".rgb";
     const auto rgb = obs.array<uint8_t>(name);
     if (rgb.shape.size() != 3 || rgb.shape[2] != 3) obs.fail(name, "uint8 [H, W, 3]");
     const int h = static_cast<int>(rgb.shape[0]), w = static_cast<int>(rgb.shape[1]);

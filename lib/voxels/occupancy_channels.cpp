@@ -14,11 +14,8 @@ ObservedSpace::ObservedSpace(const stream::Record& obs, double resolution_m) {
   planning::SceneOptions options;
   options.resolution_m = resolution_m;
   impl_ = std::make_unique<Impl>(options);
-  const std::string suffix = ".extrinsics";
-  for (const auto& field : obs.fields()) {
-    const std::string& name = field.name();
-    if (name.size() <= suffix.size() || name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) continue;
-    const std::string camera = name.substr(0, name.size() - suffix.size());
+  for (const std::string& camera : obs.prefixes(".extrinsics")) {
+    const std::string name = camera + ".extrinsics";
     stream::Record one("obs");  // one camera at a time: its rays start at its own origin
     for (const char* part : {".rgb", ".points", ".depth", ".depth_mm", ".intrinsics", ".extrinsics"})
       if (obs.has(camera + part)) one.add(obs.field(camera + part));

@@ -28,3 +28,14 @@ TEST(FieldSpec, RejectsOutOfRangeAndWrongCounts) {
   EXPECT_THROW(add_field_from_spec(r, "no_equals_sign"), Error);
   EXPECT_THROW(add_field_from_spec(r, "bad/name=1"), Error);
 }
+
+TEST(Record, PrefixesOfFieldsWithASuffix) {
+  Record r("obs");
+  add_field_from_spec(r, "front.rgb:u8=1");
+  add_field_from_spec(r, "front.depth:f32=1");
+  add_field_from_spec(r, "wrist.rgb:u8=2");
+  add_field_from_spec(r, ".rgb_not:u8=3");
+  EXPECT_EQ(r.prefixes(".rgb"), (std::vector<std::string>{"front", "wrist"}));
+  EXPECT_TRUE(r.prefixes(".points").empty());
+  EXPECT_FALSE(ends_with(".rgb", ".rgb"));  // a bare suffix names no camera
+}
