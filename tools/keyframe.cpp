@@ -31,6 +31,13 @@ static cli::Usage usage() {
       "records that refer to them by (episode_key, frame). Episodes that are empty, unsuccessful "
       "(unless --keep-failed), have frames out of order, no keyframe, or a keyframe outside the "
       "scene bounds are skipped and counted on standard error.",
+      "With --agent the input is the learning loop's own stream instead: observations with "
+      "qte-select's 'action' record after each non-terminal one (other records, such as "
+      "plan-path's trajectories, are ignored). Every action becomes one transition, from the "
+      "observation it was chosen for to the one it led to, whose reward and terminal flag it "
+      "takes; the voxel indices and bounds are the action's own, exploration included. Every "
+      "episode is kept, successful or not, and written as soon as it ends (terminal "
+      "observation), so with --append a learner following the file sees it at once.",
   };
   u.arguments = {{"FILE", "demonstrations; '-' or absent is standard input", true, false}};
   u.options = {
@@ -44,13 +51,14 @@ static cli::Usage usage() {
       {"not-demo", "", "mark the transitions as the agent's own, not demonstrations", ""},
       {"output", "FILE", "where to write; '-' is standard output", "-"},
       {"append", "", "append to --output (a growing replay file)", ""},
+      {"agent", "", "convert the agent's episodes (obs and action records) instead of demonstrations", ""},
   };
   u.uses_randomness = true;
   u.examples = {
       {"demo-record --task reach_target --episodes 10 | keyframe > demo_transitions.rec",
        "the demonstrations of a run, ready for qattn-train"},
-      {"keyframe --not-demo --every 0 --keep-failed --append --output replay.rec < episode.rec",
-       "an actor's episode added to the learner's replay"},
+      {"sim-step --task reach_target < loop | qte-select --checkpoint c.rec | plan-path | tee loop | keyframe --agent --append --output replay.rec",
+       "the actor of the learning loop: every finished episode is appended to the learner's replay"},
   };
   u.see_also = {"demo-record(1)", "voxelize(1)", "qattn-train(1)", "qte-stream(5)"};
   return u;
@@ -74,11 +82,15 @@ static void run(const cli::Arguments& args) {
   if (args.flag("append")) write_options.mode = stream::WriteMode::append;
   stream::RecordReader reader(args.positional().empty() ? "-" : args.positional()[0]);
   stream::RecordWriter writer(args.text("output"), write_options);
-  keyframes::EpisodeConverter converter(options, [&](const stream::Record& r) { writer.write(r); });
-  while (auto record = reader.next()) converter.handle(*record);
-  converter.finish();
-  writer.close();
-  std::cerr << "keyframe: " << converter.counts().summary() << "\n";
+  const auto emit = [&](const stream::Record& r) { writer.write(r); };
+  const auto convert_all = [&](auto&& converter) {
+    while (auto record = reader.next()) converter.handle(*record);
+    converter.finish();
+    writer.close();
+    std::cerr << "keyframe: " << converter.counts().summary() << "\n";
+  };
+  if (args.flag("agent")) convert_all(keyframes::AgentEpisodeConverter(options, emit));
+  else convert_all(keyframes::EpisodeConverter(options, emit));
 }
 
 int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }

@@ -25,6 +25,17 @@ Eigen::Isometry3d gripper_pose(const stream::Record& obs) {
   return pose;
 }
 
+// The episode's key: what identifies it, hashed (frames refer to it across appended files).
+int64_t episode_key_of(const std::vector<stream::Record>& episode, uint64_t seed) {
+  const std::string task = episode[0].has("task") ? episode[0].string("task") : "";
+  uint64_t key = fnv1a(task.data(), task.size());
+  const int64_t episode_seed = episode[0].has("episode_seed") ? episode[0].scalar<int64_t>("episode_seed") : 0;
+  const auto last_pose = episode.back().array<double>("gripper_pose");
+  key = fnv1a(&episode_seed, sizeof episode_seed, key);
+  key = fnv1a(last_pose.data, 7 * sizeof(double), key);
+  return static_cast<int64_t>(derive_seed(key, seed));
+}
+
 }  // namespace
 
 std::string ConversionCounts::summary() const {
@@ -38,6 +49,78 @@ std::string ConversionCounts::summary() const {
   for (const auto& [what, n] : skips)
     if (n > 0) s += "; skipped " + std::to_string(n) + " " + what;
   return s;
+}
+
+AgentEpisodeConverter::AgentEpisodeConverter(TransitionOptions options, std::function<void(const stream::Record&)> emit)
+    : options_(std::move(options)), emit_(std::move(emit)) {}
+
+void AgentEpisodeConverter::handle(const stream::Record& record) {
+  if (record.type() == "obs") {
+    if (!observations_.empty() && record.scalar<int32_t>("step") == 0) convert();  // a new episode
+    observations_.push_back(record);
+    if (record.scalar<uint8_t>("terminal") != 0) convert();
+  } else if (record.type() == "action" && !observations_.empty()) {
+    if (actions_.size() + 1 != observations_.size())
+      throw StreamError(record.position, "'action' record without an observation of its own before it");
+    actions_.push_back(record);
+  }
+}
+
+void AgentEpisodeConverter::finish() {
+  if (!observations_.empty()) convert();  // unfinished: its complete steps are still experience
+}
+
+void AgentEpisodeConverter::convert() {
+  counts_.episodes += 1;
+  const std::size_t steps = std::min(actions_.size(), observations_.size() - 1);
+  if (steps == 0) {
+    counts_.skipped_empty += 1;
+  } else {
+    const int64_t episode_key = episode_key_of(observations_, options_.seed);
+    const voxels::CoarseToFine& h = options_.hierarchy;
+    for (std::size_t t = 0; t < steps; ++t) {
+      const stream::Record &obs = observations_[t], &action = actions_[t], &next = observations_[t + 1];
+      stream::Record r("transition");
+      r.set_scalar<int64_t>("episode_key", episode_key);
+      r.set_scalar<int32_t>("frame", obs.scalar<int32_t>("frame"));
+      r.set_scalar<int32_t>("next_frame", next.scalar<int32_t>("frame"));
+      r.set_scalar<int32_t>("step", obs.scalar<int32_t>("step"));
+      r.set_scalar<int32_t>("voxels", h.voxels());
+      for (int d = 0; d < h.depths; ++d) {
+        const std::string prefix = "depth" + std::to_string(d);
+        const auto index = action.array<int32_t>(prefix + ".index");
+        const auto bounds = action.array<double>(prefix + ".bounds");
+        if (index.size() != 3) action.fail(prefix + ".index", "int32 [3]");
+        if (bounds.size() != 4) action.fail(prefix + ".bounds", "float64 [4]");
+        for (int axis = 0; axis < 3; ++axis)
+          if (index[axis] < 0 || index[axis] >= h.voxels())
+            action.fail(prefix + ".index", "indices in 0.." + std::to_string(h.voxels() - 1) + " (--voxels)");
+        r.add(action.field(prefix + ".index"));
+        r.add(action.field(prefix + ".bounds"));
+      }
+      if (action.has("depth" + std::to_string(h.depths) + ".index"))
+        action.fail("depth" + std::to_string(h.depths) + ".index",
+                    "no more than " + std::to_string(h.depths) + " depths (--depths)");
+      r.add(action.field("rotation_bins"));
+      r.set_scalar<uint8_t>("gripper_open", action.has("gripper_open") ? action.scalar<uint8_t>("gripper_open") : 1);
+      r.set_scalar<uint8_t>("ignore_collisions",
+                            action.has("ignore_collisions") ? action.scalar<uint8_t>("ignore_collisions") : 0);
+      const auto pose = action.array<double>("pose");
+      if (pose.size() != 7) action.fail("pose", "float64 [7]");
+      r.set<double>("target_pose", {7}, pose.data);
+      r.set_scalar<float>("reward", next.scalar<float>("reward"));
+      r.set_scalar<uint8_t>("terminal", next.scalar<uint8_t>("terminal"));
+      r.set_scalar<uint8_t>("demo", 0);
+      if (t == 0) emit_(frame_record(obs, episode_key));
+      emit_(frame_record(next, episode_key));
+      counts_.frames += t == 0 ? 2 : 1;
+      emit_(r);
+      counts_.transitions += 1;
+    }
+    counts_.converted += 1;
+  }
+  observations_.clear();
+  actions_.clear();
 }
 
 stream::Record frame_record(const stream::Record& obs, int64_t episode_key) {
@@ -122,14 +205,7 @@ void EpisodeConverter::convert(std::vector<stream::Record>& episode, const strea
       return;
     }
 
-  // The episode's key: what identifies it, hashed (frames refer to it across appended files).
-  const std::string task = episode[0].has("task") ? episode[0].string("task") : "";
-  uint64_t key = fnv1a(task.data(), task.size());
-  const int64_t seed = episode[0].has("episode_seed") ? episode[0].scalar<int64_t>("episode_seed") : 0;
-  const auto last_pose = episode.back().array<double>("gripper_pose");
-  key = fnv1a(&seed, sizeof seed, key);
-  key = fnv1a(last_pose.data, 7 * sizeof(double), key);
-  const int64_t episode_key = static_cast<int64_t>(derive_seed(key, options_.seed));
+  const int64_t episode_key = episode_key_of(episode, options_.seed);
 
   // Chains: from frame 0 and every n-th frame before the last keyframe, through the
   // keyframes after it.
@@ -162,6 +238,7 @@ void EpisodeConverter::convert(std::vector<stream::Record>& episode, const strea
       t.set_scalar<int32_t>("frame", episode[previous].scalar<int32_t>("frame"));
       t.set_scalar<int32_t>("next_frame", target.scalar<int32_t>("frame"));
       t.set_scalar<int32_t>("step", step);
+      t.set_scalar<int32_t>("voxels", h.voxels());
       Eigen::Vector3d centre = Eigen::Vector3d::Zero();
       for (int d = 0; d < h.depths; ++d) {
         if (d > 0) centre += shifts[d];

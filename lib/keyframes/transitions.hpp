@@ -56,6 +56,28 @@ class EpisodeConverter {
   std::mt19937_64 rng_;
 };
 
+// The agent's own episodes to transitions: the stream of the learning loop (sim-step's
+// observations with qte-select's action after each non-terminal one) gives one transition per
+// action, from the observation it was chosen for to the one it led to, with that one's reward
+// and terminal flag. The action's own per-depth indices and bounds are kept as chosen (so
+// exploration is learned from as it happened). Unsuccessful episodes are kept: they are the
+// agent's experience. Episodes end at a terminal observation or at an obs with step 0.
+class AgentEpisodeConverter {
+ public:
+  AgentEpisodeConverter(TransitionOptions options, std::function<void(const stream::Record&)> emit);
+  void handle(const stream::Record& record);
+  void finish();
+  const ConversionCounts& counts() const { return counts_; }
+
+ private:
+  void convert();
+
+  TransitionOptions options_;
+  std::function<void(const stream::Record&)> emit_;
+  std::vector<stream::Record> observations_, actions_;  // actions_[t] was chosen for observations_[t]
+  ConversionCounts counts_;
+};
+
 // The compact 'frame' record of an observation: images (rgb; depth as uint16 millimetres,
 // zstd-compressed), camera matrices and proprioception, keyed by (episode_key, frame).
 stream::Record frame_record(const stream::Record& obs, int64_t episode_key);

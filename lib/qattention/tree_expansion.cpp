@@ -27,38 +27,54 @@ int argmax(const float* q, int count) { return top_k(q, count, 1)[0]; }
 
 Choice expand(const DepthEvaluator& evaluate, const voxels::CoarseToFine& hierarchy,
               const voxels::PointCloud& cloud, const std::vector<float>& proprio, int k) {
+  return expand_batch(evaluate, hierarchy, {cloud}, {proprio}, k).front();
+}
+
+std::vector<Choice> expand_batch(const DepthEvaluator& evaluate, const voxels::CoarseToFine& hierarchy,
+                                 const std::vector<voxels::PointCloud>& clouds,
+                                 const std::vector<std::vector<float>>& proprios, int k) {
   if (k < 1) throw Error("tree expansion needs k >= 1");
+  if (clouds.size() != proprios.size() || clouds.empty())
+    throw Error("tree expansion needs one proprio vector per point cloud");
   const int depths = hierarchy.depths, v = hierarchy.voxels(), cells = v * v * v;
   const std::size_t grid_floats = static_cast<std::size_t>(cells) * voxels::kChannels;
 
-  // Level by level, every node of the tree: its grid, its parent and the voxel of the parent
-  // it expands, and (filled after the forward) its Q volume.
+  // Level by level, every node of the trees: its grid, its observation, its parent and the
+  // voxel of the parent it expands, and (filled after the forward) its Q volume. Children are
+  // appended in their parents' order, so each level's nodes are grouped by observation.
   struct Node {
     voxels::GridBounds bounds;
+    int observation = 0;
     int parent = -1;
     int parent_voxel = -1;
   };
   std::vector<std::vector<Node>> levels(depths);
   std::vector<nets::QValues> outputs(depths);
-  levels[0].push_back({hierarchy.scene, -1, -1});
-  Choice choice;
+  for (std::size_t i = 0; i < clouds.size(); ++i) levels[0].push_back({hierarchy.scene, static_cast<int>(i), -1, -1});
+  int expanded_grids = 0;
   for (int d = 0; d < depths; ++d) {
-    std::vector<voxels::GridBounds> grids;
-    for (const Node& node : levels[d]) grids.push_back(node.bounds);
-    std::vector<float> batch(grid_floats * grids.size());
-    voxels::voxelize_many(cloud, grids, batch.data());
-    const int n = static_cast<int>(grids.size());
+    const std::vector<Node>& level = levels[d];
+    const int n = static_cast<int>(level.size());
+    std::vector<float> batch(grid_floats * n);
     std::vector<float> proprio_batch;
-    for (int i = 0; i < n; ++i) proprio_batch.insert(proprio_batch.end(), proprio.begin(), proprio.end());
+    for (int first = 0; first < n;) {  // one pass over each observation's points for all its grids
+      int last = first;
+      std::vector<voxels::GridBounds> grids;
+      while (last < n && level[last].observation == level[first].observation) grids.push_back(level[last++].bounds);
+      voxels::voxelize_many(clouds[level[first].observation], grids, batch.data() + first * grid_floats);
+      first = last;
+    }
+    for (const Node& node : level)
+      proprio_batch.insert(proprio_batch.end(), proprios[node.observation].begin(), proprios[node.observation].end());
     outputs[d] = evaluate(d, batch.data(), proprio_batch.data(), n);
     if (static_cast<int>(outputs[d].translation.size()) != n * cells)
       throw Error("tree expansion: depth " + std::to_string(d) + " returned the wrong number of Q values");
-    choice.expanded_grids += n;
+    expanded_grids += n;
     if (d + 1 == depths) break;
     for (int i = 0; i < n; ++i)
       for (int flat : top_k(outputs[d].translation.data() + static_cast<std::size_t>(i) * cells, cells, k))
-        levels[d + 1].push_back(
-            {hierarchy.bounds_at(d + 1, levels[d][i].bounds.centre_of(unflatten(flat, v))), i, flat});
+        levels[d + 1].push_back({hierarchy.bounds_at(d + 1, level[i].bounds.centre_of(unflatten(flat, v))),
+                                 level[i].observation, i, flat});
   }
 
   // Values bottom-up: a leaf is worth its max Q; a node's value through child c is
@@ -83,26 +99,36 @@ Choice expand(const DepthEvaluator& evaluate, const voxels::CoarseToFine& hierar
       }
     }
   }
-  // Follow the best path from the root.
-  int node = 0;
-  choice.value = value[0][0];
-  for (int d = 0; d < depths; ++d) {
-    const float* q = outputs[d].translation.data() + static_cast<std::size_t>(node) * cells;
-    const int voxel = d + 1 < depths ? levels[d + 1][best_child[d][node]].parent_voxel : argmax(q, cells);
-    choice.indices.push_back(unflatten(voxel, v));
-    choice.bounds.push_back(levels[d][node].bounds);
-    choice.q_values.push_back(q[voxel]);
-    if (d + 1 < depths) node = best_child[d][node];
+  // Follow each tree's best path from its root.
+  std::vector<Choice> choices(clouds.size());
+  for (std::size_t root = 0; root < clouds.size(); ++root) {
+    Choice& choice = choices[root];
+    choice.expanded_grids = expanded_grids;
+    int node = static_cast<int>(root);
+    choice.value = value[0][node];
+    for (int d = 0; d < depths; ++d) {
+      const float* q = outputs[d].translation.data() + static_cast<std::size_t>(node) * cells;
+      const int voxel = d + 1 < depths ? levels[d + 1][best_child[d][node]].parent_voxel : argmax(q, cells);
+      choice.indices.push_back(unflatten(voxel, v));
+      choice.bounds.push_back(levels[d][node].bounds);
+      choice.q_values.push_back(q[voxel]);
+      if (d + 1 < depths) node = best_child[d][node];
+    }
+    const nets::QValues& last = outputs[leaf];
+    if (!last.rotation.empty()) {
+      const float* r =
+          last.rotation.data() + static_cast<std::size_t>(node) * nets::kRotationAxes * nets::kRotationBins;
+      for (int axis = 0; axis < nets::kRotationAxes; ++axis) {
+        const float* axis_q = r + axis * nets::kRotationBins;
+        choice.rotation_bins[axis] = argmax(axis_q, nets::kRotationBins);
+        choice.rotation_q[axis] = axis_q[choice.rotation_bins[axis]];
+      }
+      const float* g = last.gripper.data() + static_cast<std::size_t>(node) * nets::kGripperActions;
+      choice.gripper_open = g[1] > g[0];  // index 1 = open, as the transitions' gripper_open
+      choice.gripper_q = std::max(g[0], g[1]);
+    }
   }
-  const nets::QValues& last = outputs[leaf];
-  if (!last.rotation.empty()) {
-    const float* r = last.rotation.data() + static_cast<std::size_t>(node) * nets::kRotationAxes * nets::kRotationBins;
-    for (int axis = 0; axis < nets::kRotationAxes; ++axis)
-      choice.rotation_bins[axis] = argmax(r + axis * nets::kRotationBins, nets::kRotationBins);
-    const float* g = last.gripper.data() + static_cast<std::size_t>(node) * nets::kGripperActions;
-    choice.gripper_open = g[1] > g[0];  // index 1 = open, as the transitions' gripper_open
-  }
-  return choice;
+  return choices;
 }
 
 DepthEvaluator network_evaluator(const std::vector<nets::QAttentionNet>& nets) {

@@ -27,6 +27,8 @@ struct Choice {
   float value = 0;                            // the tree's value of the choice
   Eigen::Vector3i rotation_bins = Eigen::Vector3i::Zero();
   bool gripper_open = true;
+  Eigen::Vector3f rotation_q = Eigen::Vector3f::Zero();  // the chosen bins' Q values
+  float gripper_q = 0;                                   // the chosen gripper action's Q value
   int expanded_grids = 0;                     // grids evaluated (1 + K + K^2 + ...)
   Eigen::Vector3d position() const { return bounds.back().centre_of(indices.back()); }
 };
@@ -38,6 +40,13 @@ std::vector<int> top_k(const float* q, int count, int k);
 // (close, open), as the transitions' gripper_open 0 / 1.
 Choice expand(const DepthEvaluator& evaluate, const voxels::CoarseToFine& hierarchy,
               const voxels::PointCloud& cloud, const std::vector<float>& proprio, int k);
+
+// Tree expansion of several observations at once (the learner's bootstrap targets): every
+// depth's grids of all of them go through one batched forward. `proprios[i]` belongs to
+// `clouds[i]`; the choices come back in the same order.
+std::vector<Choice> expand_batch(const DepthEvaluator& evaluate, const voxels::CoarseToFine& hierarchy,
+                                 const std::vector<voxels::PointCloud>& clouds,
+                                 const std::vector<std::vector<float>>& proprios, int k);
 
 // The evaluator of a set of networks, one per depth.
 DepthEvaluator network_evaluator(const std::vector<nets::QAttentionNet>& nets);

@@ -96,6 +96,22 @@ void ReplayBuffer::update_priorities(const std::vector<std::size_t>& indices, co
   }
 }
 
+std::vector<double> ReplayBuffer::priorities() const {
+  std::vector<double> p(transitions_.size());
+  for (std::size_t i = 0; i < p.size(); ++i) p[i] = tree_.get(i);
+  return p;
+}
+
+void ReplayBuffer::restore_priorities(const std::vector<double>& priorities) {
+  if (priorities.size() != transitions_.size())
+    throw Error("replay: " + std::to_string(priorities.size()) + " priorities for " +
+                std::to_string(transitions_.size()) + " transitions");
+  for (std::size_t i = 0; i < priorities.size(); ++i) {
+    if (!(priorities[i] > 0) || !std::isfinite(priorities[i])) throw Error("replay: a priority is not positive");
+    tree_.set(i, priorities[i]);
+  }
+}
+
 const stream::Record& ReplayBuffer::frame_of(std::size_t index) const {
   return frames_.at(transitions_.at(index).frame).first;
 }

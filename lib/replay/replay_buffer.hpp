@@ -42,6 +42,9 @@ class ReplayBuffer {
   Sample sample(std::size_t batch, double beta, std::mt19937_64& rng) const;
   void update_priorities(const std::vector<std::size_t>& indices, const std::vector<double>& td_errors);
   double priority(std::size_t index) const { return tree_.get(index); }
+  // Every transition's priority, in index order, and back (a learner's checkpoint).
+  std::vector<double> priorities() const;
+  void restore_priorities(const std::vector<double>& priorities);
 
   const stream::Record& transition(std::size_t index) const { return transitions_.at(index).record; }
   // The observation a transition acts on, and the one it reaches.

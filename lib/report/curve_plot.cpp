@@ -1,0 +1,353 @@
+#include "report/curve_plot.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "common/atomic_file.hpp"
+#include "common/error.hpp"
+
+namespace qte::report {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Axes: round tick values within the data range
+
+struct Axis {
+  double lo = 0, hi = 1;
+  double step = 0.2;
+  std::vector<double> ticks;
+
+  double fraction(double v) const { return (v - lo) / (hi - lo); }
+};
+
+// A round step near `raw`: 1, 2 or 5 times a power of ten.
+double round_step(double raw) {
+  const double power = std::pow(10.0, std::floor(std::log10(raw)));
+  const double f = raw / power;
+  return (f < 1.5 ? 1 : f < 3 ? 2 : f < 7 ? 5 : 10) * power;
+}
+
+void set_ticks(Axis& axis, int target) {
+  axis.step = round_step((axis.hi - axis.lo) / std::max(1, target));
+  axis.ticks.clear();
+  const double first = std::ceil(axis.lo / axis.step - 1e-9);
+  for (double k = first;; ++k) {
+    double v = k * axis.step;
+    if (v > axis.hi + 1e-9 * axis.step) break;
+    if (std::fabs(v) < 1e-12 * axis.step) v = 0;  // no "-0"
+    axis.ticks.push_back(v);
+  }
+}
+
+// The data range with a margin; a flat range is widened so it has an extent.
+Axis data_axis(double lo, double hi) {
+  const bool flat = hi - lo <= 1e-12 * std::max(1.0, std::max(std::fabs(lo), std::fabs(hi)));
+  const double margin = flat ? (lo == 0 ? 0.5 : std::fabs(lo) * 0.1) : 0.04 * (hi - lo);
+  Axis axis;
+  axis.lo = lo - margin;
+  axis.hi = hi + margin;
+  return axis;
+}
+
+std::string tick_text(double v, double step) {
+  char text[32];
+  if (std::fabs(v) >= 1e6 || (v != 0 && std::fabs(v) < 1e-4)) {
+    std::snprintf(text, sizeof text, "%g", v);
+  } else {
+    const int decimals = std::max(0, -static_cast<int>(std::floor(std::log10(step) + 1e-9)));
+    std::snprintf(text, sizeof text, "%.*f", decimals, v);
+  }
+  return text;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Drawing
+
+// Tableau 10 (matplotlib's default cycle), as BGR: ten well-separated hues.
+const cv::Scalar kPalette[] = {{180, 119, 31}, {14, 127, 255}, {44, 160, 44},  {40, 39, 214},
+                               {189, 103, 148}, {75, 86, 140}, {194, 119, 227}, {127, 127, 127},
+                               {34, 189, 188}, {207, 190, 23}};
+constexpr int kPaletteSize = sizeof kPalette / sizeof kPalette[0];
+const cv::Scalar kInk{40, 40, 40}, kGrid{232, 232, 232}, kFrame{120, 120, 120};
+constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
+constexpr int kShift = 4;  // sub-pixel coordinates: 1/16 pixel
+constexpr double kSubPixel = 1 << kShift;
+
+struct Style {
+  double scale;  // 1 at 800x500
+  double tick_scale, label_scale, title_scale;
+  int thickness, line_thickness, marker_radius;
+};
+
+cv::Size text_size(const std::string& text, double scale, int thickness) {
+  int baseline = 0;
+  cv::Size s = cv::getTextSize(text, kFont, scale, thickness, &baseline);
+  return {s.width, s.height + baseline};
+}
+
+// `origin` is the top-left corner of the text's box.
+void draw_text(cv::Mat& image, const std::string& text, cv::Point origin, double scale, int thickness,
+               const cv::Scalar& colour) {
+  int baseline = 0;
+  const cv::Size s = cv::getTextSize(text, kFont, scale, thickness, &baseline);
+  cv::putText(image, text, {origin.x, origin.y + s.height}, kFont, scale, colour, thickness, cv::LINE_AA);
+}
+
+// Text turned 90 degrees counter-clockwise (reading upwards), centred on `centre`.
+void draw_text_upwards(cv::Mat& image, const std::string& text, cv::Point centre, double scale,
+                       int thickness, const cv::Scalar& colour) {
+  const cv::Size s = text_size(text, scale, thickness);
+  cv::Mat mask(s.height + 2, s.width + 2, CV_8UC1, cv::Scalar(0));
+  draw_text(mask, text, {1, 1}, scale, thickness, cv::Scalar(255));
+  cv::rotate(mask, mask, cv::ROTATE_90_COUNTERCLOCKWISE);
+  const cv::Rect where = cv::Rect(centre.x - mask.cols / 2, centre.y - mask.rows / 2, mask.cols, mask.rows) &
+                         cv::Rect(0, 0, image.cols, image.rows);
+  for (int r = 0; r < where.height; ++r)
+    for (int c = 0; c < where.width; ++c) {
+      const double a = mask.at<uint8_t>(r + where.y - (centre.y - mask.rows / 2),
+                                        c + where.x - (centre.x - mask.cols / 2)) / 255.0;
+      auto& pixel = image.at<cv::Vec3b>(where.y + r, where.x + c);
+      for (int k = 0; k < 3; ++k)
+        pixel[k] = cv::saturate_cast<uint8_t>(pixel[k] * (1 - a) + colour[k] * a);
+    }
+}
+
+struct Plot {
+  cv::Rect area;  // the data area, inside the axes
+  Axis x, y;
+
+  cv::Point2d at(double vx, double vy) const {  // relative to `area`
+    return {x.fraction(vx) * (area.width - 1), (1 - y.fraction(vy)) * (area.height - 1)};
+  }
+  static cv::Point fixed(const cv::Point2d& p) {
+    return {static_cast<int>(std::lround(p.x * kSubPixel)), static_cast<int>(std::lround(p.y * kSubPixel))};
+  }
+};
+
+// Blends a filled polygon into `image` at `alpha`: a light band that lets lines show through.
+void fill_translucent(cv::Mat& image, const std::vector<cv::Point>& polygon, const cv::Scalar& colour,
+                      double alpha) {
+  cv::Mat overlay = image.clone();
+  std::vector<std::vector<cv::Point>> polygons{polygon};
+  cv::fillPoly(overlay, polygons, colour, cv::LINE_AA, kShift);
+  cv::addWeighted(overlay, alpha, image, 1 - alpha, 0, image);
+}
+
+void draw_bands(cv::Mat& data_area, const Plot& plot, const std::vector<Curve>& curves, const Style& style) {
+  for (std::size_t i = 0; i < curves.size(); ++i) {
+    const auto& points = curves[i].points;
+    const cv::Scalar colour = kPalette[i % kPaletteSize];
+    if (points.size() == 1) {  // one x: a translucent bar instead of an area
+      const CurvePoint& p = points[0];
+      const cv::Point2d low = plot.at(p.x, p.low), high = plot.at(p.x, p.high);
+      const cv::Point2d half_width(style.marker_radius * 1.5, 0);
+      if (p.high > p.low)
+        fill_translucent(data_area, {Plot::fixed(high - half_width), Plot::fixed(high + half_width),
+                                     Plot::fixed(low + half_width), Plot::fixed(low - half_width)},
+                         colour, 0.25);
+      continue;
+    }
+    std::vector<cv::Point> polygon;
+    for (const CurvePoint& p : points) polygon.push_back(Plot::fixed(plot.at(p.x, p.high)));
+    for (auto p = points.rbegin(); p != points.rend(); ++p) polygon.push_back(Plot::fixed(plot.at(p->x, p->low)));
+    fill_translucent(data_area, polygon, colour, 0.18);
+  }
+}
+
+void draw_lines(cv::Mat& data_area, const Plot& plot, const std::vector<Curve>& curves, const Style& style) {
+  for (std::size_t i = 0; i < curves.size(); ++i) {
+    const auto& points = curves[i].points;
+    const cv::Scalar colour = kPalette[i % kPaletteSize];
+    for (std::size_t k = 1; k < points.size(); ++k)
+      cv::line(data_area, Plot::fixed(plot.at(points[k - 1].x, points[k - 1].mean)),
+               Plot::fixed(plot.at(points[k].x, points[k].mean)), colour, style.line_thickness, cv::LINE_AA,
+               kShift);
+    for (const CurvePoint& p : points)
+      cv::circle(data_area, Plot::fixed(plot.at(p.x, p.mean)), style.marker_radius * static_cast<int>(kSubPixel),
+                 colour, cv::FILLED, cv::LINE_AA, kShift);
+  }
+}
+
+// How much of the curves' lines lies inside `box` (relative to the data area).
+int64_t ink_inside(const cv::Rect& box, const Plot& plot, const std::vector<Curve>& curves) {
+  int64_t count = 0;
+  for (const Curve& curve : curves)
+    for (std::size_t k = 0; k < curve.points.size(); ++k) {
+      const cv::Point2d b = plot.at(curve.points[k].x, curve.points[k].mean);
+      const cv::Point2d a = k ? plot.at(curve.points[k - 1].x, curve.points[k - 1].mean) : b;
+      const int samples = 1 + static_cast<int>(cv::norm(b - a) / 2);
+      for (int s = 0; s <= samples; ++s) {
+        const cv::Point2d p = a + (b - a) * (static_cast<double>(s) / samples);
+        count += box.contains(cv::Point(static_cast<int>(p.x), static_cast<int>(p.y)));
+      }
+    }
+  return count;
+}
+
+void draw_legend(cv::Mat& image, const Plot& plot, const std::vector<Curve>& curves, const Style& style) {
+  const int pad = 8, swatch = 24, row_height = text_size("Ag", style.label_scale, style.thickness).height + 6;
+  int text_width = 0;
+  for (const Curve& c : curves)
+    text_width = std::max(text_width, text_size(c.name, style.label_scale, style.thickness).width);
+  const cv::Size box(pad * 3 + swatch + text_width, pad * 2 + row_height * static_cast<int>(curves.size()));
+  const int inset = 10;
+  const int right = plot.area.width - box.width - inset, bottom = plot.area.height - box.height - inset;
+  // Corners in order of preference; the one crossing the fewest line pixels wins.
+  const cv::Point corners[] = {{inset, inset}, {right, inset}, {right, bottom}, {inset, bottom}};
+  cv::Point best = corners[0];
+  int64_t least = -1;
+  for (const cv::Point& c : corners) {
+    const int64_t ink = ink_inside(cv::Rect(c, box), plot, curves);
+    if (least < 0 || ink < least) least = ink, best = c;
+  }
+  const cv::Rect frame(plot.area.tl() + best, box);
+  cv::Mat region = image(frame & cv::Rect(0, 0, image.cols, image.rows));
+  cv::addWeighted(region, 0.15, cv::Mat(region.size(), region.type(), cv::Scalar(255, 255, 255)), 0.85, 0, region);
+  cv::rectangle(image, frame, cv::Scalar(200, 200, 200), 1, cv::LINE_AA);
+  for (std::size_t i = 0; i < curves.size(); ++i) {
+    const int top = frame.y + pad + row_height * static_cast<int>(i);
+    const int middle = top + row_height / 2;
+    const cv::Scalar colour = kPalette[i % kPaletteSize];
+    cv::line(image, {frame.x + pad, middle}, {frame.x + pad + swatch, middle}, colour, style.line_thickness,
+             cv::LINE_AA);
+    cv::circle(image, {frame.x + pad + swatch / 2, middle}, style.marker_radius, colour, cv::FILLED, cv::LINE_AA);
+    const cv::Size s = text_size(curves[i].name, style.label_scale, style.thickness);
+    draw_text(image, curves[i].name, {frame.x + pad * 2 + swatch, middle - s.height / 2}, style.label_scale,
+              style.thickness, kInk);
+  }
+}
+
+struct Labels {
+  std::string title, x, y;
+  bool legend = false;
+};
+
+int y_tick_target(int height, const Style& style) {
+  return std::max(2, static_cast<int>(height / (60 * style.scale)));
+}
+
+// Picks ticks for the axes so that their numbers do not collide.
+void choose_ticks(Plot& plot, const Style& style) {
+  for (int target = std::max(2, static_cast<int>(plot.area.width / (90 * style.scale))); target >= 2; --target) {
+    set_ticks(plot.x, target);
+    int widest = 0;
+    for (double v : plot.x.ticks)
+      widest = std::max(widest, text_size(tick_text(v, plot.x.step), style.tick_scale, style.thickness).width);
+    const double spacing = plot.x.step / (plot.x.hi - plot.x.lo) * plot.area.width;
+    if (widest + 16 <= spacing) break;
+  }
+  set_ticks(plot.y, y_tick_target(plot.area.height, style));
+}
+
+cv::Mat draw(const std::vector<Curve>& curves, Axis x_axis, Axis y_axis, const Labels& labels, cv::Size size) {
+  const double scale = std::clamp(std::min(size.width / 800.0, size.height / 500.0), 0.6, 3.0);
+  Style style{scale, 0.42 * scale, 0.5 * scale, 0.62 * scale, std::max(1, static_cast<int>(std::lround(scale))),
+              std::max(1, static_cast<int>(std::lround(2 * scale))),
+              std::max(2, static_cast<int>(std::lround(3 * scale)))};
+  cv::Mat image(size, CV_8UC3, cv::Scalar(255, 255, 255));
+
+  // Margins from the text they hold; the y tick numbers are measured once ticks are known, so
+  // lay out twice (the y ticks depend only on the height).
+  const int tick_height = text_size("0", style.tick_scale, style.thickness).height;
+  const int label_height = text_size("Ag", style.label_scale, style.thickness).height;
+  const int title_height = labels.title.empty() ? 0 : text_size("Ag", style.title_scale, style.thickness).height;
+  const int gap = static_cast<int>(8 * scale), tick_length = static_cast<int>(5 * scale);
+  const int top = gap * 2 + (title_height ? title_height + gap : 0);
+  const int bottom = tick_length + gap + tick_height + (labels.x.empty() ? 0 : gap + label_height) + gap * 2;
+  Plot plot{cv::Rect(0, top, size.width, size.height - top - bottom), x_axis, y_axis};
+  set_ticks(plot.y, y_tick_target(plot.area.height, style));
+  int y_numbers = 0;
+  for (double v : plot.y.ticks)
+    y_numbers = std::max(y_numbers, text_size(tick_text(v, plot.y.step), style.tick_scale, style.thickness).width);
+  const int left = gap + (labels.y.empty() ? 0 : label_height + gap) + y_numbers + gap + tick_length;
+  const int right = gap * 3;
+  plot.area = cv::Rect(left, top, size.width - left - right, size.height - top - bottom);
+  if (plot.area.width < 40 || plot.area.height < 40) throw UsageError("--size is too small for the axes and labels");
+  choose_ticks(plot, style);
+
+  // Grid, then bands and lines clipped to the data area, then axes and text on top.
+  for (double v : plot.x.ticks) {
+    const int px = plot.area.x + static_cast<int>(std::lround(plot.at(v, 0).x));
+    cv::line(image, {px, plot.area.y}, {px, plot.area.br().y - 1}, kGrid, 1);
+  }
+  for (double v : plot.y.ticks) {
+    const int py = plot.area.y + static_cast<int>(std::lround(plot.at(0, v).y));
+    cv::line(image, {plot.area.x, py}, {plot.area.br().x - 1, py}, kGrid, 1);
+  }
+  cv::Mat data_area = image(plot.area);
+  draw_bands(data_area, plot, curves, style);
+  draw_lines(data_area, plot, curves, style);
+  cv::rectangle(image, plot.area.tl() - cv::Point(1, 1), plot.area.br(), kFrame, 1);
+
+  for (double v : plot.x.ticks) {
+    const int px = plot.area.x + static_cast<int>(std::lround(plot.at(v, 0).x));
+    cv::line(image, {px, plot.area.br().y}, {px, plot.area.br().y + tick_length}, kFrame, 1);
+    const std::string text = tick_text(v, plot.x.step);
+    const cv::Size s = text_size(text, style.tick_scale, style.thickness);
+    draw_text(image, text, {px - s.width / 2, plot.area.br().y + tick_length + gap / 2}, style.tick_scale,
+              style.thickness, kInk);
+  }
+  for (double v : plot.y.ticks) {
+    const int py = plot.area.y + static_cast<int>(std::lround(plot.at(0, v).y));
+    cv::line(image, {plot.area.x - 1 - tick_length, py}, {plot.area.x - 1, py}, kFrame, 1);
+    const std::string text = tick_text(v, plot.y.step);
+    const cv::Size s = text_size(text, style.tick_scale, style.thickness);
+    draw_text(image, text, {plot.area.x - 1 - tick_length - gap / 2 - s.width, py - s.height / 2},
+              style.tick_scale, style.thickness, kInk);
+  }
+  if (!labels.x.empty()) {
+    const cv::Size s = text_size(labels.x, style.label_scale, style.thickness);
+    draw_text(image, labels.x, {plot.area.x + plot.area.width / 2 - s.width / 2, size.height - gap * 2 - s.height},
+              style.label_scale, style.thickness, kInk);
+  }
+  if (!labels.y.empty())
+    draw_text_upwards(image, labels.y, {gap + label_height / 2, plot.area.y + plot.area.height / 2},
+                      style.label_scale, style.thickness, kInk);
+  if (!labels.title.empty()) {
+    const cv::Size s = text_size(labels.title, style.title_scale, style.thickness);
+    draw_text(image, labels.title, {plot.area.x + plot.area.width / 2 - s.width / 2, gap * 2}, style.title_scale,
+              style.thickness, kInk);
+  }
+  if (labels.legend) draw_legend(image, plot, curves, style);
+  return image;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The picture of `curves` with axes spanning their points and bands (or the fixed y range).
+cv::Mat draw_curves(const std::vector<Curve>& curves, const CurvePlotOptions& options) {
+  double x_lo = INFINITY, x_hi = -INFINITY, y_lo = INFINITY, y_hi = -INFINITY;
+  for (const Curve& curve : curves)
+    for (const CurvePoint& p : curve.points) {
+      x_lo = std::min(x_lo, p.x), x_hi = std::max(x_hi, p.x);
+      y_lo = std::min({y_lo, p.mean, p.low}), y_hi = std::max({y_hi, p.mean, p.high});
+    }
+  Axis y_axis = data_axis(y_lo, y_hi);
+  if (options.fixed_y) {
+    y_axis.lo = options.y_min;
+    y_axis.hi = options.y_max;
+  }
+  const Labels labels{options.title, options.x_label, options.y_label, options.legend};
+  return draw(curves, data_axis(x_lo, x_hi), y_axis, labels, cv::Size(options.width_px, options.height_px));
+}
+
+std::vector<uint8_t> encode_png(const cv::Mat& image, const std::string& what) {
+  std::vector<uint8_t> png;
+  if (!cv::imencode(".png", image, png)) throw Error("cannot encode " + what + " as PNG");
+  return png;
+}
+
+}  // namespace
+
+std::vector<uint8_t> curve_plot_png(const std::vector<Curve>& curves, const CurvePlotOptions& options) {
+  return encode_png(draw_curves(curves, options), "the curves");
+}
+
+void save_curve_plot(const std::string& path, const std::vector<Curve>& curves, const CurvePlotOptions& options) {
+  const std::vector<uint8_t> png = encode_png(draw_curves(curves, options), path);
+  write_file_atomically(path, png.data(), png.size());
+}
+
+}  // namespace qte::report

@@ -1,0 +1,96 @@
+// Prints the cost of one full learner step of qattn-train on 2 threads, and what it is made
+// of: sampling, voxelization of the batch (current grids at every depth), the bootstrap
+// targets (next-state grids and no-grad forwards of online and target networks, or tree
+// expansion with --tree-target), and the forward + backward + Adam + soft update. The
+// transitions are pick_and_lift demonstrations recorded in-process (10 episodes, 128x128).
+//
+// The reference's bare network step (forward + backward + Adam at one depth, no data) is
+// printed by /usr/bin/python3 shared/bench/torch_qattention_ref.py 2; run it back to back.
+// Options: --arch light|arm, --batch B, --tree-target K, --steps N, --threads N.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "demos/demo_recorder.hpp"
+#include "keyframes/transitions.hpp"
+#include "learner/q_learner.hpp"
+#include "replay/replay_buffer.hpp"
+
+using namespace qte;
+using Clock = std::chrono::steady_clock;
+
+static double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+static double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[v.size() / 2];
+}
+
+int main(int argc, char** argv) {
+  std::string arch = "light";
+  int batch = 32, tree = 0, steps = 5, threads = 2;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string a = argv[i];
+    if (a == "--arch") arch = argv[i + 1];
+    else if (a == "--batch") batch = std::atoi(argv[i + 1]);
+    else if (a == "--tree-target") tree = std::atoi(argv[i + 1]);
+    else if (a == "--steps") steps = std::atoi(argv[i + 1]);
+    else if (a == "--threads") threads = std::atoi(argv[i + 1]);
+  }
+  nets::set_torch_threads(threads);
+  nets::seed_torch(1);
+
+  learner::LearnerConfig config;
+  config.net.architecture = nets::architecture_from_name(arch);
+  config.net.base_channels = nets::default_base_channels(config.net.architecture);
+  config.batch = batch;
+  config.tree_target_k = tree;
+
+  replay::ReplayBuffer replay;
+  keyframes::TransitionOptions transition_options;
+  transition_options.hierarchy = config.hierarchy;
+  keyframes::EpisodeConverter converter(transition_options, [&](const stream::Record& r) { replay.add(r); });
+  demos::DemoOptions demo_options;
+  demo_options.episodes = {"pick_and_lift", 0, 10, 1};
+  demos::record_demos(robot::RobotModel::xarm7(), demo_options, [&](const stream::Record& r) { converter.handle(r); },
+                      [](const std::string&) {});
+  converter.finish();
+  std::printf("replay: %zu transitions, %zu frames (10 pick_and_lift demos)\n", replay.size(), replay.frame_count());
+
+  learner::QLearner learner(config);
+  std::vector<double> sample_s, assemble_s, target_s, full_s;
+  for (int step = 0; step <= steps; ++step) {  // step 0 warms up
+    std::mt19937_64 rng(step);
+    const auto t0 = Clock::now();
+    const replay::Sample sample = replay.sample(batch, 1.0, rng);
+    const double t_sample = since(t0);
+    const auto t1 = Clock::now();
+    const learner::Minibatch mb = learner::assemble_minibatch(replay, sample, config);
+    const double t_assemble = since(t1);
+    const auto t2 = Clock::now();
+    learner.targets(mb);  // timed alone; train_step computes them again
+    const double t_targets = since(t2);
+    const auto t3 = Clock::now();
+    const learner::StepStats stats = learner.train_step(mb);
+    replay.update_priorities(sample.indices, stats.td_errors);
+    const double t_train = since(t3);
+    if (step == 0) continue;
+    sample_s.push_back(t_sample);
+    assemble_s.push_back(t_assemble);
+    target_s.push_back(t_targets);
+    full_s.push_back(t_sample + t_assemble + t_train);
+  }
+  const double full = median(full_s), targets = median(target_s), assemble = median(assemble_s);
+  std::printf("%s batch %d, %d depths, tree target K=%d, %d threads, median of %d steps:\n", arch.c_str(), batch,
+              config.hierarchy.depths, tree, threads, steps);
+  std::printf("  full step        %.3f s  (sampling %.4f, voxelizing the batch %.3f, targets %.3f, "
+              "forward+backward+Adam of all depths %.3f)\n",
+              full, median(sample_s), assemble, targets, full - median(sample_s) - assemble - targets);
+  std::printf("  per depth        %.3f s  (full step / depths: compare with the reference's bare step per depth)\n",
+              full / config.hierarchy.depths);
+  return 0;
+}
