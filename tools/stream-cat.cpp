@@ -1,7 +1,9 @@
 // stream-cat: concatenate, filter and validate record streams.
+#include <cmath>
 #include <set>
 
 #include "cli/command.hpp"
+#include "stream/inspect.hpp"
 #include "stream/reader.hpp"
 #include "stream/writer.hpp"
 
@@ -24,6 +26,7 @@ static cli::Usage usage() {
       {"append", "", "append to --output instead of replacing it", ""},
       {"type", "T", "keep only records of type T", "", true},
       {"exclude", "T", "drop records of type T", "", true},
+      {"where", "NAME=VALUE", "keep only records whose scalar or text field NAME equals VALUE (numbers compare as numbers)", "", true},
       {"head", "N", "stop after N records have been written; -1 for no limit", "-1"},
       {"max-record-bytes", "N", "treat a record payload or decompressed field larger than N bytes as damage",
        std::to_string(uint64_t(4) << 30)},
@@ -33,10 +36,30 @@ static cli::Usage usage() {
       {"stream-cat --type transition --append --output replay.rec < episode.rec",
        "add an episode's transitions to a growing replay file"},
       {"stream-cat --head 1 demos.rec | stream-dump", "look at the first record only"},
+      {"stream-cat --type obs --where frame=0 demos.rec > starts.rec", "the first observation of every demonstration"},
   };
   u.see_also = {"qte-stream(5)", "stream-dump(1)", "stream-pack(1)"};
   return u;
 }
+
+namespace {
+
+// --where NAME=VALUE: a scalar field equal to the number VALUE, or a text field equal to VALUE.
+struct Condition {
+  std::string name, value;
+  bool holds(const stream::Record& record) const {
+    const stream::Field* field = record.find(name);
+    if (field == nullptr) return false;
+    if (field->dtype() == stream::DType::str) return record.string(name) == value;
+    if (field->element_count() != 1) return false;
+    char* end = nullptr;
+    const double wanted = std::strtod(value.c_str(), &end);
+    if (end == value.c_str() || *end != '\0') return false;
+    return stream::element_as_double(*field, 0) == wanted;
+  }
+};
+
+}  // namespace
 
 static void run(const cli::Arguments& args) {
   std::vector<std::string> files = args.positional();
@@ -45,6 +68,12 @@ static void run(const cli::Arguments& args) {
   const std::set<std::string> keep_types(keep.begin(), keep.end()),
       drop_types(drop.begin(), drop.end());
   const int64_t head = args.integer("head");
+  std::vector<Condition> conditions;
+  for (const std::string& where : args.all("where")) {
+    const auto eq = where.find('=');
+    if (eq == std::string::npos || eq == 0) throw UsageError("--where expects NAME=VALUE, got '" + where + "'");
+    conditions.push_back({where.substr(0, eq), where.substr(eq + 1)});
+  }
   stream::ReadOptions read_options;
   if (args.integer("max-record-bytes") <= 0) throw UsageError("--max-record-bytes must be positive");
   read_options.max_record_bytes = static_cast<uint64_t>(args.integer("max-record-bytes"));
@@ -58,6 +87,9 @@ static void run(const cli::Arguments& args) {
       if (!record) break;
       if (!keep_types.empty() && !keep_types.count(record->type())) continue;
       if (drop_types.count(record->type())) continue;
+      bool wanted = true;
+      for (const Condition& c : conditions) wanted = wanted && c.holds(*record);
+      if (!wanted) continue;
       writer.write(*record);
     }
   }

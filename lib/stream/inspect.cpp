@@ -25,6 +25,27 @@ std::string format_float(double v, int digits) {
   return buf;
 }
 
+}  // namespace
+
+double element_as_double(const Field& f, int64_t i) {
+  switch (f.dtype()) {
+    case DType::u8: return element<uint8_t>(f, i);
+    case DType::i8: return element<int8_t>(f, i);
+    case DType::u16: return element<uint16_t>(f, i);
+    case DType::i16: return element<int16_t>(f, i);
+    case DType::u32: return element<uint32_t>(f, i);
+    case DType::i32: return element<int32_t>(f, i);
+    case DType::u64: return static_cast<double>(element<uint64_t>(f, i));
+    case DType::i64: return static_cast<double>(element<int64_t>(f, i));
+    case DType::f32: return element<float>(f, i);
+    case DType::f64: return element<double>(f, i);
+    case DType::str: break;
+  }
+  return std::nan("");
+}
+
+namespace {
+
 // Value i as text; `for_json` quotes non-finite floats so the line stays valid JSON.
 std::string value_text(const Field& f, int64_t i, bool for_json) {
   auto real = [&](double v, int digits) {

@@ -25,4 +25,7 @@ void print_record_json(std::ostream& out, const Record& record, uint64_t record_
 // JSON string literal with escapes.
 std::string json_quote(const std::string& text);
 
+// Element i of a numeric field as a double (NaN for text fields).
+double element_as_double(const Field& field, int64_t i);
+
 }  // namespace qte::stream

@@ -76,11 +76,17 @@ void save_voxel_png(const std::string& path, const float* grid, int voxels, cons
       cv::fillConvexPoly(image, corners, cv::Scalar(bgr[0] * shade[f], bgr[1] * shade[f], bgr[2] * shade[f]), cv::LINE_AA);
       cv::polylines(image, corners, true, cv::Scalar(60, 60, 60), 1, cv::LINE_AA);
     }
-    if (x == options.marked_x && y == options.marked_y && z == options.marked_z)
-      for (int f = 0; f < 3; ++f) {
-        std::vector<cv::Point> corners;
-        for (const auto& c : faces[f]) corners.push_back(project(x + c[0], y + c[1], z + c[2], voxels, options.size_px));
-        cv::polylines(image, corners, true, cv::Scalar(0, 0, 255), 2, cv::LINE_AA);
+  }
+  // The marked voxel's outline last, all twelve edges, so cubes in front do not hide it.
+  if (options.marked_x >= 0 && options.marked_y >= 0 && options.marked_z >= 0) {
+    const int x = options.marked_x, y = options.marked_y, z = options.marked_z;
+    for (int a = 0; a < 8; ++a)
+      for (int bit = 1; bit < 8; bit <<= 1) {
+        const int b = a | bit;
+        if (b == a) continue;
+        cv::line(image, project(x + (a & 1), y + (a >> 1 & 1), z + (a >> 2 & 1), voxels, options.size_px),
+                 project(x + (b & 1), y + (b >> 1 & 1), z + (b >> 2 & 1), voxels, options.size_px),
+                 cv::Scalar(0, 0, 255), 2, cv::LINE_AA);
       }
   }
   std::vector<uint8_t> png;

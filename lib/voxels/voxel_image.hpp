@@ -13,7 +13,7 @@ struct VoxelImageOptions {
   // low blue, high red) instead of mean RGB, and draw every voxel above `min_value`.
   std::vector<float> values;
   float min_value = -1e30f;
-  // Voxel to outline (e.g. the chosen one), or -1.
+  // Voxel to outline in red, over everything drawn (e.g. the chosen one), or -1.
   int marked_x = -1, marked_y = -1, marked_z = -1;
 };
 

@@ -1,7 +1,12 @@
 // Tree expansion: K = 1 is the greedy coarse-to-fine choice; K > 1 lets a finer depth overturn
-// a coarse choice; branches are evaluated in one batched call per depth.
+// a coarse choice; branches are evaluated in one batched call per depth, and the batched
+// expansion chooses what the paper's Algorithm 2, run one branch at a time, chooses.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
 #include <random>
 
 #include "qattention/tree_expansion.hpp"
@@ -126,4 +131,278 @@ TEST(TreeExpansion, RealNetworksGreedyEqualsManualArgmax) {
   const Choice wide = expand(network_evaluator(networks), hierarchy, cloud.view(), proprio, 5);
   EXPECT_EQ(wide.expanded_grids, 6);
   EXPECT_GE(wide.value, c.value - 1e-6f);
+}
+
+namespace {
+
+// ---- The paper's Algorithm 2 written plainly: a recursion with one forward per branch ----
+
+Eigen::Vector3i voxel_of(int flat_index) { return {flat_index / (V * V), (flat_index / V) % V, flat_index % V}; }
+
+int first_best(const float* q, int count) { return static_cast<int>(std::max_element(q, q + count) - q); }
+
+// The k best voxels, best first, equal Q in index order (as top_k, written independently).
+std::vector<int> k_best(const float* q, int k) {
+  std::vector<int> order(kCells);
+  for (int i = 0; i < kCells; ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return q[a] > q[b]; });
+  order.resize(std::min(k, kCells));
+  return order;
+}
+
+struct Path {
+  float value = 0;
+  std::vector<Eigen::Vector3i> indices;
+  std::vector<float> q_values;
+  Eigen::Vector3i rotation_bins = Eigen::Vector3i::Zero();
+  bool gripper_open = true;
+};
+
+// QTE(depth, obs, centre): voxelize the grid; at the last depth return its max Q; otherwise
+// recurse below each of the top-K voxels and return the best (q_k + q'_k) / 2.
+Path algorithm2(const DepthEvaluator& evaluate, const voxels::CoarseToFine& hierarchy, const voxels::PointCloud& cloud,
+                const std::vector<float>& proprio, int k, int depth, const voxels::GridBounds& bounds, int& calls) {
+  std::vector<float> grid(static_cast<std::size_t>(kCells) * voxels::kChannels);
+  voxels::voxelize(cloud, bounds, grid.data());
+  const nets::QValues out = evaluate(depth, grid.data(), proprio.data(), 1);
+  calls += 1;
+  const float* q = out.translation.data();
+  Path best;
+  if (depth + 1 == hierarchy.depths) {
+    const int a = first_best(q, kCells);
+    best.value = q[a];
+    best.indices = {voxel_of(a)};
+    best.q_values = {q[a]};
+    if (!out.rotation.empty()) {
+      for (int axis = 0; axis < 3; ++axis) best.rotation_bins[axis] = first_best(out.rotation.data() + axis * 72, 72);
+      best.gripper_open = out.gripper[1] > out.gripper[0];
+    }
+    return best;
+  }
+  best.value = -std::numeric_limits<float>::infinity();
+  for (int voxel : k_best(q, k)) {
+    Path below = algorithm2(evaluate, hierarchy, cloud, proprio, k, depth + 1,
+                            hierarchy.bounds_at(depth + 1, bounds.centre_of(voxel_of(voxel))), calls);
+    const float value = (q[voxel] + below.value) / 2;
+    if (value > best.value) {  // the first of equal values, as max() over the list
+      best = below;
+      best.value = value;
+      best.indices.insert(best.indices.begin(), voxel_of(voxel));
+      best.q_values.insert(best.q_values.begin(), q[voxel]);
+    }
+  }
+  return best;
+}
+
+// A Q function of the grid's content alone (so a grid's Qs do not depend on the batch it is
+// in), irregular enough that top-K and max have no ties: per voxel from its mean point, colour
+// and index; rotation and gripper from the whole grid.
+nets::QValues content_q(int depth, const float* grids, const float*, int batch) {
+  nets::QValues out;
+  out.batch = batch;
+  out.translation.resize(static_cast<std::size_t>(batch) * kCells);
+  out.rotation.resize(static_cast<std::size_t>(batch) * 3 * 72);
+  out.gripper.resize(static_cast<std::size_t>(batch) * 2);
+  for (int b = 0; b < batch; ++b) {
+    double sum_x = 0, occupied = 0;
+    for (int cell = 0; cell < kCells; ++cell) {
+      const float* c = grids + (static_cast<std::size_t>(b) * kCells + cell) * voxels::kChannels;
+      const float point = c[9] * std::sin(17 * c[0] + 29 * c[1] + 41 * c[2] + depth);
+      out.translation[static_cast<std::size_t>(b) * kCells + cell] =
+          point + 0.25f * c[9] * c[3] + 0.1f * std::cos(13 * c[6] + 7 * c[7] + 5 * c[8] + 0.3f * depth);
+      sum_x += c[0];
+      occupied += c[9];
+    }
+    for (int i = 0; i < 3 * 72; ++i)
+      out.rotation[static_cast<std::size_t>(b) * 216 + i] =
+          static_cast<float>(std::sin(0.37 * i * (1 + occupied) + sum_x));
+    out.gripper[b * 2] = static_cast<float>(std::sin(sum_x));
+    out.gripper[b * 2 + 1] = static_cast<float>(std::cos(sum_x));
+  }
+  return out;
+}
+
+// Batched expand and the plain recursion side by side; `exact`: the same floats (a Q function
+// of the grid alone), otherwise equal up to the rounding of batched against single forwards.
+void expect_same_as_algorithm2(const DepthEvaluator& evaluate, int depths, int k, const voxels::PointCloud& cloud,
+                               bool exact) {
+  SCOPED_TRACE("depths " + std::to_string(depths) + ", K " + std::to_string(k));
+  voxels::CoarseToFine hierarchy;
+  hierarchy.depths = depths;
+  const std::vector<float> proprio = {1, 0.04f, 0.04f, 0.5f};
+  int batched_calls = 0, plain_calls = 0;
+  const DepthEvaluator counted = [&](int depth, const float* grids, const float* p, int batch) {
+    batched_calls += 1;
+    return evaluate(depth, grids, p, batch);
+  };
+  const Choice c = expand(counted, hierarchy, cloud, proprio, k);
+  const Path p = algorithm2(evaluate, hierarchy, cloud, proprio, k, 0, hierarchy.scene, plain_calls);
+  int grids = 0;
+  for (int d = 0, width = 1; d < depths; ++d, width *= k) grids += width;  // 1 + K + K^2 + ...
+  EXPECT_EQ(batched_calls, depths);  // one batched forward per depth
+  EXPECT_EQ(plain_calls, grids);     // one forward per branch
+  EXPECT_EQ(c.expanded_grids, grids);
+  ASSERT_EQ(c.indices.size(), static_cast<std::size_t>(depths));
+  for (int d = 0; d < depths; ++d) {
+    EXPECT_EQ(c.indices[d], p.indices[d]) << "depth " << d;
+    if (exact)
+      EXPECT_EQ(c.q_values[d], p.q_values[d]) << "depth " << d;
+    else
+      EXPECT_NEAR(c.q_values[d], p.q_values[d], 1e-5) << "depth " << d;
+  }
+  if (exact)
+    EXPECT_EQ(c.value, p.value);
+  else
+    EXPECT_NEAR(c.value, p.value, 1e-5);
+  EXPECT_EQ(c.rotation_bins, p.rotation_bins);
+  EXPECT_EQ(c.gripper_open, p.gripper_open);
+}
+
+// Points of a small object: a 3 x 3 x 3 lattice, 8 mm apart, around `centre`.
+void add_object(const Eigen::Vector3d& centre, std::array<uint8_t, 3> colour, std::vector<float>& xyz,
+                std::vector<uint8_t>& rgb) {
+  for (int i = -1; i <= 1; ++i)
+    for (int j = -1; j <= 1; ++j)
+      for (int l = -1; l <= 1; ++l) {
+        const Eigen::Vector3d p = centre + 0.008 * Eigen::Vector3d(i, j, l);
+        xyz.insert(xyz.end(), {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())});
+        rgb.insert(rgb.end(), colour.begin(), colour.end());
+      }
+}
+
+}  // namespace
+
+// Coarse ambiguity, the case QTE is for: two yellow shapes the coarse grid cannot tell apart
+// (one voxel each, the same colour to its Q function; the distractor, 1 cm taller, scores a
+// little higher), the fine grid can (it sees the target's shade).
+TEST(TreeExpansion, FinerDepthResolvesCoarseAmbiguityBetweenTwoObjects) {
+  const voxels::CoarseToFine hierarchy;
+  const Eigen::Vector3d target = hierarchy.scene.centre_of({4, 8, 4});
+  const Eigen::Vector3d distractor = hierarchy.scene.centre_of({11, 4, 4}) + Eigen::Vector3d(0, 0, 0.01);
+  std::vector<float> xyz;
+  std::vector<uint8_t> rgb;
+  add_object(target, {250, 210, 0}, xyz, rgb);
+  add_object(distractor, {250, 210, 60}, xyz, rgb);
+  const voxels::PointCloud cloud{xyz.data(), rgb.data(), rgb.size() / 3};
+
+  const DepthEvaluator q = [](int depth, const float* grids, const float*, int batch) {
+    nets::QValues out;
+    out.batch = batch;
+    out.translation.assign(static_cast<std::size_t>(batch) * kCells, depth == 0 ? 0.0f : -1.0f);
+    for (int b = 0; b < batch; ++b)
+      for (int cell = 0; cell < kCells; ++cell) {
+        const float* c = grids + (static_cast<std::size_t>(b) * kCells + cell) * voxels::kChannels;
+        if (c[9] == 0) continue;  // empty
+        float& value = out.translation[static_cast<std::size_t>(b) * kCells + cell];
+        if (depth == 0)
+          value = 0.5f + 0.1f * (c[2] - 0.6f);  // any yellow thing; taller is a little better
+        else
+          value = c[5] < -0.9f ? 1.0f : 0.0f;   // the target's shade (no blue) only
+      }
+    return out;
+  };
+  const Choice greedy = expand(q, hierarchy, cloud, {1, 0.04f, 0.04f, 1}, 1);
+  EXPECT_EQ(greedy.indices[0], Eigen::Vector3i(11, 4, 4));  // the distractor, by its coarse Q
+  EXPECT_LT((greedy.position() - distractor).norm(), 0.03);
+  EXPECT_NEAR(greedy.value, (greedy.q_values[0] + 0.0f) / 2, 1e-7);
+  for (int k : {2, 5, 10}) {
+    SCOPED_TRACE("K " + std::to_string(k));
+    const Choice c = expand(q, hierarchy, cloud, {1, 0.04f, 0.04f, 1}, k);
+    EXPECT_EQ(c.indices[0], Eigen::Vector3i(4, 8, 4));  // the target, by what depth 1 sees
+    EXPECT_LT((c.position() - target).norm(), 0.02);
+    EXPECT_LT(c.q_values[0], greedy.q_values[0]);       // though its coarse Q is lower
+    EXPECT_FLOAT_EQ(c.q_values[1], 1.0f);
+    EXPECT_FLOAT_EQ(c.value, (c.q_values[0] + 1.0f) / 2);
+  }
+}
+
+// Three depths by hand. Four points, labelled by their red value, in two groups (green) that
+// fall in one depth-0 voxel each; deeper grids hold each point in a voxel of its own. Empty
+// voxels have Q -1. Q by depth and label:
+//   depth 0: group A 0.625, group B 0.5625
+//   depth 1: a1 0.25, a2 0.5, b1 0.875, b2 0.125
+//   depth 2: a1 0.75, a2 0,   b1 0,     b2 0.625
+// A depth-2 grid (centre +- 0.15 m) holds both points of its group, so a leaf below group A is
+// worth 0.75 and one below group B 0.625. Below A: a2 (0.5 + 0.75) / 2 = 0.625 beats a1 0.5;
+// below B: b1 (0.875 + 0.625) / 2 = 0.75. Root: A (0.625 + 0.625) / 2 = 0.625 against B
+// (0.5625 + 0.75) / 2 = 0.65625: K = 2 goes B, b1, b2. Greedy goes A, a2, a1: 0.625.
+TEST(TreeExpansion, ThreeDepthsNestAsAlgorithmTwoByHand) {
+  voxels::CoarseToFine hierarchy;
+  hierarchy.depths = 3;
+  const Eigen::Vector3d group_a = hierarchy.scene.centre_of({4, 8, 4});
+  const Eigen::Vector3d group_b = hierarchy.scene.centre_of({11, 4, 4});
+  const Eigen::Vector3d along_x(0.02, 0, 0), along_y(0, 0.02, 0);
+  const std::array<Eigen::Vector3d, 4> points = {group_a - along_x, group_a + along_x,   // a1, a2
+                                                 group_b - along_y, group_b + along_y};  // b1, b2
+  std::vector<float> xyz;
+  std::vector<uint8_t> rgb;
+  for (int label = 0; label < 4; ++label) {
+    const Eigen::Vector3f p = points[label].cast<float>();
+    xyz.insert(xyz.end(), {p.x(), p.y(), p.z()});
+    rgb.insert(rgb.end(), {static_cast<uint8_t>(64 * label), static_cast<uint8_t>(label < 2 ? 0 : 255), 0});
+  }
+  const voxels::PointCloud cloud{xyz.data(), rgb.data(), rgb.size() / 3};
+  const float by_group[2] = {0.625f, 0.5625f};
+  const float by_label[3][4] = {{0, 0, 0, 0}, {0.25f, 0.5f, 0.875f, 0.125f}, {0.75f, 0.0f, 0.0f, 0.625f}};
+  const DepthEvaluator q = [&](int depth, const float* grids, const float*, int batch) {
+    nets::QValues out;
+    out.batch = batch;
+    out.translation.assign(static_cast<std::size_t>(batch) * kCells, -1.0f);
+    for (int b = 0; b < batch; ++b)
+      for (int cell = 0; cell < kCells; ++cell) {
+        const float* c = grids + (static_cast<std::size_t>(b) * kCells + cell) * voxels::kChannels;
+        if (c[9] == 0) continue;
+        const int label = static_cast<int>(std::lround((c[3] + 1) * 127.5f / 64));
+        out.translation[static_cast<std::size_t>(b) * kCells + cell] =
+            depth == 0 ? by_group[c[4] > 0 ? 1 : 0] : by_label[depth][label];
+      }
+    return out;
+  };
+  const std::vector<float> proprio = {1, 0.04f, 0.04f, 1};
+  // The voxel of `point` at each depth along the path through it.
+  const auto path_to = [&](const Eigen::Vector3d& first, const Eigen::Vector3d& second, const Eigen::Vector3d& third) {
+    std::vector<Eigen::Vector3i> indices;
+    voxels::GridBounds bounds = hierarchy.scene;
+    for (const Eigen::Vector3d& p : {first, second, third}) {
+      indices.push_back(bounds.index_of(p));
+      bounds = hierarchy.bounds_at(static_cast<int>(indices.size()), bounds.centre_of(indices.back()));
+    }
+    return indices;
+  };
+
+  const Choice greedy = expand(q, hierarchy, cloud, proprio, 1);
+  EXPECT_EQ(greedy.indices, path_to(points[0], points[1], points[0]));  // A, a2, a1
+  EXPECT_EQ(greedy.q_values, (std::vector<float>{0.625f, 0.5f, 0.75f}));
+  EXPECT_EQ(greedy.value, 0.625f);  // (0.625 + (0.5 + 0.75) / 2) / 2
+  EXPECT_EQ(greedy.expanded_grids, 3);
+
+  const Choice two = expand(q, hierarchy, cloud, proprio, 2);
+  EXPECT_EQ(two.indices, path_to(points[2], points[2], points[3]));  // B, b1, b2
+  EXPECT_EQ(two.q_values, (std::vector<float>{0.5625f, 0.875f, 0.625f}));
+  EXPECT_EQ(two.value, 0.65625f);  // (0.5625 + (0.875 + 0.625) / 2) / 2
+  EXPECT_EQ(two.expanded_grids, 1 + 2 + 4);
+  EXPECT_LT((two.position() - points[3]).norm(), 0.3 / V);
+
+  // More branches only add worse ones (empty voxels, Q -1): the same choice.
+  const Choice ten = expand(q, hierarchy, cloud, proprio, 10);
+  EXPECT_EQ(ten.indices, two.indices);
+  EXPECT_EQ(ten.value, two.value);
+  EXPECT_EQ(ten.expanded_grids, 1 + 10 + 100);
+  for (int k : {1, 2, 10}) expect_same_as_algorithm2(q, 3, k, cloud, true);
+}
+
+TEST(TreeExpansion, BatchedEqualsAlgorithmTwoOneBranchAtATime) {
+  const Cloud cloud;
+  for (int depths : {2, 3})
+    for (int k : {1, 2, 5}) expect_same_as_algorithm2(content_q, depths, k, cloud.view(), true);
+}
+
+TEST(TreeExpansion, BatchedEqualsAlgorithmTwoOnRealNetworks) {
+  const Cloud cloud;
+  nets::NetConfig config;  // light, 16^3, 10 channels, 4 proprio
+  for (int depths : {2, 3}) {
+    nets::seed_torch(5 + depths);
+    const auto networks = nets::make_coarse_to_fine_nets(config, depths);
+    for (int k : {1, 2, 5}) expect_same_as_algorithm2(network_evaluator(networks), depths, k, cloud.view(), false);
+  }
 }

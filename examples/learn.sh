@@ -1,0 +1,98 @@
+#!/usr/bin/env bash
+# The online learning loop of C2F-ARM (+QTE), assembled from the toolkit's programs:
+#
+#   demo-record | keyframe                      demonstrations -> replay.rec (once)
+#   qattn-train --follow replay.rec &           the learner: trains as replay.rec grows,
+#                                               writes ckpt/step-N.rec and ckpt/latest.rec
+#   sim-step < loop | qte-select --reload | plan-path | tee loop | keyframe --agent --append
+#                                               the actor: a closed pipeline through a FIFO;
+#                                               every finished episode is appended to replay.rec
+#   sim-step | qte-select (greedy) | plan-path | episode-stats
+#                                               evaluation on held-out seeds after each chunk
+#
+# Usage: learn.sh TASK RUN_DIR   (settings from the environment; see examples/Makefile)
+# Resumable: finished chunks and evaluations are kept, the learner resumes from its last
+# checkpoint; an interrupted chunk is run again (its finished episodes stay in the replay).
+set -euo pipefail
+task=$1 run=$2
+: "${SEED:=0}" "${DEMOS:=10}" "${VARIATION:=0}" "${IMAGE:=128x128}" "${ACT_K:=10}" "${TARGET_K:=10}"
+: "${ENV_STEPS:=2000}" "${CHUNK_EPISODES:=10}" "${EVAL_EPISODES:=50}" "${EVAL_SEED:=1000000}"
+: "${ARCH:=light}" "${BATCH:=32}" "${RATIO:=0.5}" "${PRETRAIN:=200}" "${START_AFTER:=200}"
+: "${LEARNER_THREADS:=1}" "${EPSILON:=0.1}" "${ROTATION_NOISE:=1}" "${CHECKPOINT_EVERY:=25}" "${LABEL:=k$ACT_K-$TARGET_K}"
+mkdir -p "$run/chunks" "$run/eval"
+log() { printf '%s %s\n' "$(date +%H:%M:%S)" "$*" >&2; }
+
+# 1. Demonstrations -> transitions (once; written under a temporary name, then renamed).
+if [ ! -f "$run/replay.rec" ]; then
+  log "$task: $DEMOS demonstrations"
+  demo-record --task "$task" --episodes "$DEMOS" --seed "$SEED" --variation "$VARIATION" --image-size "$IMAGE" \
+    --compress --output "$run/demos.rec" 2>> "$run/demos.log"
+  keyframe --seed "$SEED" --output "$run/replay.rec.tmp" "$run/demos.rec" 2>> "$run/demos.log"
+  mv "$run/replay.rec.tmp" "$run/replay.rec"
+fi
+
+# 2. The learner, in the background for the whole run.
+rm -f "$run/actor.done"
+qattn-train --follow --resume --stop-file "$run/actor.done" --replay-ratio "$RATIO" --pretrain "$PRETRAIN" \
+  --start-after "$START_AFTER" --steps 1000000 --checkpoint-every "$CHECKPOINT_EVERY" --keep 4 \
+  --architecture "$ARCH" --batch "$BATCH" --tree-target "$TARGET_K" --seed "$SEED" --threads "$LEARNER_THREADS" \
+  --checkpoint-dir "$run/ckpt" --metrics "$run/train.csv" "$run/replay.rec" 2>> "$run/train.log" &
+learner=$!
+trap 'kill $learner 2>/dev/null || true' EXIT
+while [ ! -f "$run/ckpt/latest.rec" ]; do kill -0 $learner || { tail -2 "$run/train.log"; exit 1; }; sleep 0.5; done
+
+# The learner's newest step, from its checkpoint names.
+learner_step() { ls "$run/ckpt" | sed -n 's/^step-0*\([0-9][0-9]*\)\.rec$/\1/p' | sort -n | tail -1; }
+# Waits until the learner has taken the steps the replay ratio allows for `agent` transitions.
+wait_for_learner() {
+  local want=$(( PRETRAIN + $(awk -v r="$RATIO" -v n="$1" 'BEGIN { printf "%d", r * n }') ))
+  want=$(( want / CHECKPOINT_EVERY * CHECKPOINT_EVERY ))
+  while [ "$(learner_step)" -lt "$want" ]; do kill -0 $learner || { tail -2 "$run/train.log"; exit 1; }; sleep 1; done
+}
+# Greedy episodes of one checkpoint on the held-out seeds -> one CSV row.
+evaluate() {  # CHECKPOINT ENV_STEPS OUT.csv LEARNER_STEP
+  local fifo; fifo=$(mktemp -u); mkfifo "$fifo"
+  sim-step --task "$task" --variation "$VARIATION" --episodes "$EVAL_EPISODES" --seed "$EVAL_SEED" \
+    --image-size "$IMAGE" < "$fifo" \
+    | qte-select --checkpoint "$1" --k "$ACT_K" --threads 1 \
+    | plan-path | tee "$fifo" \
+    | episode-stats --label "$LABEL" --column seed="$SEED" --column env_steps="$2" --column train_step="$4" \
+        > "$3.tmp"
+  rm -f "$fifo"
+  mv "$3.tmp" "$3"
+}
+
+env_steps=0 chunk=0
+while :; do
+  # Evaluate what the learner has made of the experience so far.
+  wait_for_learner "$env_steps"
+  eval_csv=$run/eval/$(printf '%06d' "$env_steps").csv
+  if [ ! -f "$eval_csv" ]; then
+    snapshot=$run/eval/checkpoint.rec
+    until step=$(learner_step) && cp "$run/ckpt/step-$(printf '%08d' "$step").rec" "$snapshot" 2>/dev/null; do sleep 0.2; done
+    evaluate "$snapshot" "$env_steps" "$eval_csv" "$step"
+    log "$task $LABEL seed $SEED: env steps $env_steps, learner step $step: $(tail -1 "$eval_csv")"
+  fi
+  [ "$env_steps" -ge "$ENV_STEPS" ] && break
+
+  # One chunk of exploring episodes through the closed loop.
+  name=$run/chunks/$(printf '%04d' "$chunk")
+  if [ ! -f "$name.rec" ]; then
+    fifo=$(mktemp -u); mkfifo "$fifo"
+    sim-step --task "$task" --variation "$VARIATION" --episodes "$CHUNK_EPISODES" --seed $((SEED * 100000 + chunk)) \
+      --image-size "$IMAGE" --compress < "$fifo" \
+      | qte-select --checkpoint "$run/ckpt/latest.rec" --reload --k "$ACT_K" --epsilon "$EPSILON" \
+          --rotation-noise "$ROTATION_NOISE" --seed $((SEED * 100000 + chunk)) --threads 1 2>> "$run/actor.log" \
+      | plan-path | tee "$fifo" "$name.partial" \
+      | keyframe --agent --seed "$SEED" --append --output "$run/replay.rec" 2>> "$run/actor.log"
+    rm -f "$fifo"
+    mv "$name.partial" "$name.rec"
+  fi
+  env_steps=$(( env_steps + $(stream-dump --summary "$name.rec" | awk '$1 == "action" { print $2 }') ))
+  chunk=$((chunk + 1))
+done
+touch "$run/actor.done"
+wait $learner || true
+trap - EXIT
+cat "$run"/eval/*.csv | awk 'NR == 1 || !/^label/' > "$run/eval.csv"
+log "$task $LABEL seed $SEED: done; $run/eval.csv"

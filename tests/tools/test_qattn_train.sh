@@ -1,0 +1,69 @@
+#!/usr/bin/env bash
+# qattn-train as a program: initial networks, training with metrics, checkpoints that resume
+# byte for byte after an interruption or a kill, following a growing replay, bad input.
+source "$(dirname "$0")/common.sh"
+
+demo-record --task lift_numbered_block --episodes 2 --seed 3 --image-size 48x48 --output "$tmp/demos.rec" 2>/dev/null \
+  || fail "demo-record"
+keyframe --seed 1 --output "$tmp/tr.rec" "$tmp/demos.rec" 2>/dev/null || fail "keyframe"
+train() { qattn-train --batch 4 --start-after 4 --seed 5 --log-every 2 "$@"; }
+
+# --steps 0: the initial networks, at once, for an actor to start with.
+train --steps 0 --checkpoint-dir "$tmp/init" "$tmp/tr.rec" 2>/dev/null || fail "--steps 0"
+[ -f "$tmp/init/step-00000000.rec" ] && [ -f "$tmp/init/latest.rec" ] || fail "no initial checkpoint"
+stream-dump --summary "$tmp/init/latest.rec" | grep -q "^checkpoint	2 records" || fail "checkpoint records"
+stream-dump --summary "$tmp/init/latest.rec" | grep -q "^learner	1 records" || fail "learner state"
+
+# Six steps straight, and three + three with --resume: the same bytes.
+train --steps 6 --checkpoint-every 3 --keep 2 --metrics "$tmp/a.csv" --checkpoint-dir "$tmp/a" "$tmp/tr.rec" \
+  2> "$tmp/a.log" || fail "train: $(tail -3 "$tmp/a.log")"
+grep -q "qattn-train: step 6/6  loss" "$tmp/a.log" || fail "no progress line: $(cat "$tmp/a.log")"
+[ "$(ls "$tmp/a" | tr '\n' ' ')" = "latest.rec step-00000003.rec step-00000006.rec " ] || fail "kept: $(ls "$tmp/a")"
+head -1 "$tmp/a.csv" | grep -q "^step,transitions,agent_transitions,replay,demos,loss,loss_d0,loss_d1,q_mean_d0" \
+  || fail "metrics header: $(head -1 "$tmp/a.csv")"
+[ "$(cut -d, -f1 "$tmp/a.csv" | tail -n +2 | tr '\n' ' ')" = "2 4 6 " ] || fail "metrics rows: $(cat "$tmp/a.csv")"
+train --steps 3 --checkpoint-every 3 --metrics "$tmp/b.csv" --checkpoint-dir "$tmp/b" "$tmp/tr.rec" 2>/dev/null || fail "b"
+train --steps 6 --checkpoint-every 3 --metrics "$tmp/b.csv" --checkpoint-dir "$tmp/b" --resume "$tmp/tr.rec" \
+  2> "$tmp/b.log" || fail "resume: $(cat "$tmp/b.log")"
+grep -q "resumed at step 3" "$tmp/b.log" || fail "$(cat "$tmp/b.log")"
+cmp -s "$tmp/a/latest.rec" "$tmp/b/latest.rec" || fail "a resumed run differs from an uninterrupted one"
+[ "$(cut -d, -f1 "$tmp/b.csv" | tr '\n' ' ')" = "step 2 3 4 6 " ] || fail "resumed metrics: $(cat "$tmp/b.csv")"
+
+# Killed mid-run: the last checkpoint is whole and the run resumes from it.
+train --steps 1000 --checkpoint-every 2 --checkpoint-dir "$tmp/k" "$tmp/tr.rec" 2>/dev/null &
+pid=$!
+for _ in $(seq 600); do [ -f "$tmp/k/step-00000004.rec" ] && break; sleep 0.1; done
+kill -9 $pid; wait $pid 2>/dev/null
+stream-dump --summary "$tmp/k/latest.rec" > /dev/null || fail "the checkpoint after a kill is damaged"
+ls -a "$tmp/k" | grep -q tmp && fail "temporary files left: $(ls -a "$tmp/k")"
+train --steps 5 --checkpoint-dir "$tmp/k" --resume "$tmp/tr.rec" 2> "$tmp/k.log" || fail "resume after kill: $(cat "$tmp/k.log")"
+grep -q "resumed at step [2-9]" "$tmp/k.log" || fail "$(cat "$tmp/k.log")"
+
+# Following a replay file being appended to: trains as transitions arrive, stops on request.
+stream-cat --head 3 "$tmp/tr.rec" > "$tmp/grow.rec"
+qattn-train --follow --pretrain 4 --replay-ratio 1 --start-after 1 --batch 2 --steps 100 --stop-file "$tmp/stop" \
+  --checkpoint-dir "$tmp/f" "$tmp/grow.rec" 2> "$tmp/f.log" &
+pid=$!
+stream-cat "$tmp/tr.rec" | stream-cat --append --output "$tmp/grow.rec"
+touch "$tmp/stop"
+for _ in $(seq 600); do kill -0 $pid 2>/dev/null || break; sleep 0.1; done
+kill -0 $pid 2>/dev/null && { kill $pid; fail "--follow did not stop at --stop-file"; }
+wait $pid || fail "follow run: $(cat "$tmp/f.log")"
+[ -f "$tmp/f/step-00000004.rec" ] || fail "--pretrain 4 without agent transitions: $(ls "$tmp/f"; cat "$tmp/f.log")"
+
+# Bad input: other settings, another grid, non-finite loss, missing file, too few transitions.
+err=$(train --steps 6 --architecture arm --base-channels 8 --checkpoint-dir "$tmp/a" --resume "$tmp/tr.rec" 2>&1) \
+  && fail "another architecture resumed"
+grep -q "trained with other settings.*\"architecture\": \"light\"" <<<"$err" || fail "$err"
+keyframe --voxels 8 --seed 1 "$tmp/demos.rec" > "$tmp/tr8.rec" 2>/dev/null
+err=$(train --steps 2 --checkpoint-dir "$tmp/v" "$tmp/tr8.rec" 2>&1) && fail "8-voxel transitions accepted"
+grep -q "tr8.rec: record [0-9]* at byte [0-9]*: 'transition' record, field 'voxels': expected 16 voxels" <<<"$err" || fail "$err"
+err=$(train --steps 40 --lr 1e30 --grad-clip 0 --checkpoint-every 1000 --checkpoint-dir "$tmp/n" "$tmp/tr.rec" 2>&1) \
+  && fail "a diverging run did not stop"
+grep -q "step [0-9]*: non-finite loss.*tr.rec: record [0-9]* at byte.*last good checkpoint is .*step-00000000.rec" \
+  <<<"$(tail -1 <<<"$err")" || fail "$err"
+err=$(train --steps 2 --checkpoint-dir "$tmp/m" "$tmp/missing.rec" 2>&1) && fail "missing file accepted"
+grep -q "missing.rec" <<<"$err" || fail "$err"
+err=$(qattn-train --steps 2 --start-after 1000 --checkpoint-dir "$tmp/s" "$tmp/tr.rec" 2>&1) && fail "too few transitions"
+grep -q "fewer than --start-after 1000" <<<"$err" || fail "$err"
+echo "qattn-train ok"
