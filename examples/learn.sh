@@ -16,8 +16,8 @@
 set -euo pipefail
 task=$1 run=$2
 : "${SEED:=0}" "${DEMOS:=10}" "${VARIATION:=0}" "${IMAGE:=128x128}" "${ACT_K:=10}" "${TARGET_K:=10}"
-: "${ENV_STEPS:=2000}" "${CHUNK_EPISODES:=10}" "${EVAL_EPISODES:=50}" "${EVAL_SEED:=1000000}"
-: "${ARCH:=light}" "${BATCH:=32}" "${RATIO:=0.5}" "${PRETRAIN:=200}" "${START_AFTER:=200}"
+: "${ENV_STEPS:=2000}" "${CHUNK_EPISODES:=10}" "${EVAL_EVERY:=250}" "${EVAL_EPISODES:=50}" "${EVAL_SEED:=1000000}"
+: "${ARCH:=light}" "${BATCH:=32}" "${RATIO:=0.5}" "${PRETRAIN:=200}" "${START_AFTER:=0}"
 : "${LEARNER_THREADS:=1}" "${EPSILON:=0.1}" "${ROTATION_NOISE:=1}" "${CHECKPOINT_EVERY:=25}" "${LABEL:=k$ACT_K-$TARGET_K}"
 mkdir -p "$run/chunks" "$run/eval"
 log() { printf '%s %s\n' "$(date +%H:%M:%S)" "$*" >&2; }
@@ -64,10 +64,12 @@ evaluate() {  # CHECKPOINT ENV_STEPS OUT.csv LEARNER_STEP
 
 env_steps=0 chunk=0
 while :; do
-  # Evaluate what the learner has made of the experience so far.
-  wait_for_learner "$env_steps"
-  eval_csv=$run/eval/$(printf '%06d' "$env_steps").csv
+  # Every EVAL_EVERY environment steps and at the end: evaluate what the learner has made of
+  # the experience so far, once it has taken the steps the replay ratio allows.
+  mark=$(( env_steps >= ENV_STEPS ? 999999 : env_steps / EVAL_EVERY ))
+  eval_csv=$run/eval/$(printf '%06d' "$mark").csv
   if [ ! -f "$eval_csv" ]; then
+    wait_for_learner "$env_steps"
     snapshot=$run/eval/checkpoint.rec
     until step=$(learner_step) && cp "$run/ckpt/step-$(printf '%08d' "$step").rec" "$snapshot" 2>/dev/null; do sleep 0.2; done
     evaluate "$snapshot" "$env_steps" "$eval_csv" "$step"

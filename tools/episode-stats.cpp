@@ -46,8 +46,8 @@ static cli::Usage usage() {
       {"per-episode", "", "print one row per episode instead of the summary", ""},
   };
   u.examples = {
-      {"sim-step --task reach_target --episodes 25 < fifo | tee log.rec | voxelize | qte-select "
-       "--model m.rec | plan-path > fifo; episode-stats log.rec",
+      {"sim-step --task reach_target --episodes 25 < fifo | tee log.rec | qte-select "
+       "--checkpoint ckpt/latest.rec | plan-path > fifo; episode-stats log.rec",
        "success rate of an evaluation run"},
       {"episode-stats --label qte --column seed=1 --column step=20000 --no-header eval.rec >> curves.csv",
        "append one row for method qte, seed 1, training step 20000 to a table for plot-curves "

@@ -41,7 +41,7 @@ static cli::Usage usage() {
   };
   u.uses_randomness = true;
   u.examples = {
-      {"sim-step --task reach_target < fifo | voxelize | qte-select --model m.rec | plan-path > fifo",
+      {"sim-step --task reach_target < fifo | qte-select --checkpoint ckpt/latest.rec | plan-path > fifo",
        "the planner in the actor loop"},
       {"plan-path --octomap scene.bt < episode.rec | stream-dump --type trajectory",
        "re-plan a saved episode and look at the map"},

@@ -70,7 +70,7 @@ static cli::Usage usage() {
       {"follow", "", "keep reading the inputs as they grow; pace training by --replay-ratio", ""},
       {"stop-file", "FILE", "with --follow: finish once FILE exists and the allowed steps are done", ""},
       {"replay-ratio", "R", "with --follow: gradient steps per agent transition", "1"},
-      {"pretrain", "N", "with --follow: steps allowed before any agent transition", "0"},
+      {"pretrain", "N", "with --follow: steps allowed before any agent transition, on the demonstrations even below --start-after", "0"},
       {"start-after", "N", "train once the replay holds N transitions (demos included)", "200"},
       {"checkpoint-every", "N", "steps between checkpoints", "100"},
       {"keep", "N", "numbered checkpoints to keep", "3"},
@@ -249,7 +249,9 @@ static void run(const cli::Arguments& args) {
   while (learner.step() < total_steps) {
     ingest(INT64_MAX);
     const int64_t allowed = follow ? pretrain + static_cast<int64_t>(replay_ratio * agent_transitions) : INT64_MAX;
-    const bool enough = static_cast<int64_t>(replay.size()) >= start_after && replay.size() > 0;
+    // --pretrain steps may be taken on whatever the replay holds (the demonstrations).
+    const bool enough = replay.size() > 0 && (static_cast<int64_t>(replay.size()) >= start_after ||
+                                              (follow && learner.step() < pretrain));
     if (!enough || learner.step() >= allowed) {
       if (!follow)
         throw Error("the inputs hold " + std::to_string(replay.size()) + " transitions, fewer than --start-after " +
@@ -308,4 +310,7 @@ static void run(const cli::Arguments& args) {
   if (learner.step() != last_saved) save();
 }
 
-int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }
+int main(int argc, char** argv) {
+  nets::use_passive_openmp_waits(argv);
+  return cli::run_tool(argc, argv, usage(), run);
+}

@@ -389,4 +389,7 @@ static void run(const cli::Arguments& args) {
   writer.close();
 }
 
-int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }
+int main(int argc, char** argv) {
+  nets::use_passive_openmp_waits(argv);
+  return cli::run_tool(argc, argv, usage(), run);
+}

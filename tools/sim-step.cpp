@@ -1,4 +1,6 @@
 // sim-step: the simulator as a filter: reset and trajectory records in, observations out.
+#include <unistd.h>
+
 #include "cli/command.hpp"
 #include "simulator/simulator.hpp"
 #include "stream/reader.hpp"
@@ -24,7 +26,9 @@ static cli::Usage usage() {
       "field, as an invalid action does in RLBench. An episode also ends after 10 next-best "
       "poses. With --task, sim-step starts episodes by itself (the next one after each terminal "
       "observation) until --episodes have run; reset records on the input start one at any "
-      "time. Other record types are ignored.",
+      "time. Other record types are ignored. After the last of --episodes it closes its "
+      "output and reads its input to the end, so that an actor loop closed by a FIFO "
+      "winds down without broken pipes.",
       "Cameras are rendered without a GPU, one ray per pixel against Bullet's collision world, "
       "with per-object colours, diffuse shading and textures (the digits of "
       "lift_numbered_block). Tasks: reach_target, pick_and_lift, lift_numbered_block.",
@@ -47,7 +51,7 @@ static cli::Usage usage() {
   u.examples = {
       {"sim-step --task reach_target --seed 3 < /dev/null | stream-png --dir frames/",
        "one reset, its first front image saved as PNG"},
-      {"sim-step --task pick_and_lift --episodes 100 < fifo | voxelize | qte-select --model m.rec | plan-path > fifo",
+      {"sim-step --task pick_and_lift --episodes 100 < fifo | qte-select --checkpoint ckpt/latest.rec | plan-path > fifo",
        "an actor: the learning loop closed by a FIFO"},
       {"stream-pack reset task=lift_numbered_block variation:i32=1 seed:i64=5 | sim-step --image-size 256x256",
        "one explicit reset, 256x256 images"},
@@ -86,6 +90,16 @@ static void run(const cli::Arguments& args) {
       },
       [&](const stream::Record& obs) { writer.write(obs); });
   writer.close();
+  if (!plan) return;
+  // The last episode is over, but in a FIFO loop its last records are still on their way
+  // back to us. Closing standard output lets the programs downstream see the end of the
+  // stream, finish and close the FIFO; reading our input to its end meanwhile spares them
+  // a broken pipe (exit 141) on the records they still pass on.
+  if (args.text("output") == "-") ::close(STDOUT_FILENO);
+  if (input == "-" && ::isatty(STDIN_FILENO)) return;
+  if (!reader) reader = std::make_unique<stream::RecordReader>(input);
+  while (reader->next()) {
+  }
 }
 
 int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }

@@ -1,5 +1,9 @@
 #include "nets/qattention_net.hpp"
 
+#include <unistd.h>
+
+#include <cstdlib>
+
 #include "common/error.hpp"
 #include "nets/qattention_modules.hpp"
 
@@ -72,6 +76,12 @@ std::vector<QAttentionNet> make_coarse_to_fine_nets(NetConfig config, int depths
 }
 
 void seed_torch(uint64_t seed) { torch::manual_seed(seed); }
+
+void use_passive_openmp_waits(char** argv) {
+  if (std::getenv("OMP_WAIT_POLICY") != nullptr) return;
+  ::setenv("OMP_WAIT_POLICY", "PASSIVE", 1);
+  ::execv("/proc/self/exe", argv);  // on failure, carry on with spinning waits
+}
 
 void set_torch_threads(int threads) {
   if (threads < 1) throw Error("torch threads must be >= 1, got " + std::to_string(threads));

@@ -83,4 +83,12 @@ void seed_torch(uint64_t seed);
 // Intra-op threads of LibTorch (its default is every core).
 void set_torch_threads(int threads);
 
+// LibTorch's OpenMP threads spin while they wait for work. When two programs share the cores
+// (the learner and the actor of the learning loop on 2 cores), a spinning thread takes the
+// core its partner needs: we measured steps 5x and acting 50x slower. libgomp reads
+// OMP_WAIT_POLICY once, when it loads, so programs that run networks call this first thing in
+// main(): unless the user has set OMP_WAIT_POLICY, it sets it to PASSIVE and executes the
+// program again (same arguments). Returns only when nothing needs to change.
+void use_passive_openmp_waits(char** argv);
+
 }  // namespace qte::nets

@@ -1,0 +1,68 @@
+#!/usr/bin/env python3
+"""The whole data path, checked by behaviour cloning (issue 6): 20 reach_target demonstrations
+(variation 0: the red target among two distractors of other colours) through keyframe into
+qattn-train, 300 steps on the demonstrations alone; then on 20 held-out demonstrations the
+greedy coarse-to-fine choice of qte-select --k 1 on each first observation must land within
+one final-depth voxel of the demonstration's keyframe (its final gripper position: every
+axis within 1.5 voxels of 1.875 cm, i.e. in that voxel or its neighbour) in >= 80% of cases.
+About 4 minutes on 2 cores. Run with a python3 that has NumPy (ctest uses /usr/bin/python3)."""
+import importlib.util
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+TOOLS = os.environ.get("QTE_TOOLS") or "/work/main/build/tools"
+SOURCE = os.environ.get("QTE_SOURCE") or "/work/main"
+spec = importlib.util.spec_from_file_location("read_stream", os.path.join(SOURCE, "examples", "read_stream.py"))
+read_stream = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(read_stream)
+tmp = tempfile.mkdtemp(prefix="qte_bc_")
+
+
+def run(name, *args):
+    r = subprocess.run([os.path.join(TOOLS, name), *args], capture_output=True, text=True)
+    if r.returncode != 0:
+        sys.exit(f"FAIL: {name} {' '.join(args)}: exit {r.returncode}: {r.stderr.strip()[-500:]}")
+    return r
+
+
+def path(name):
+    return os.path.join(tmp, name)
+
+
+try:
+    run("demo-record", "--task", "reach_target", "--episodes", "20", "--seed", "1", "--variation", "0",
+        "--compress", "--output", path("demos.rec"))
+    run("keyframe", "--seed", "1", "--output", path("train.rec"), path("demos.rec"))
+    run("qattn-train", "--steps", "300", "--start-after", "10", "--checkpoint-every", "300", "--seed", "1",
+        "--checkpoint-dir", path("ckpt"), path("train.rec"))
+    run("demo-record", "--task", "reach_target", "--episodes", "20", "--seed", "99", "--variation", "0",
+        "--output", path("held_out.rec"))
+    run("stream-cat", "--type", "obs", "--where", "frame=0", "--output", path("starts.rec"), path("held_out.rec"))
+    run("qte-select", "--checkpoint", path("ckpt/latest.rec"), "--k", "1", "--output", path("actions.rec"),
+        path("starts.rec"))
+
+    episodes = []
+    for r in read_stream.read_records(path("held_out.rec")):
+        if r.type == "obs":
+            if int(r.fields["frame"]) == 0:
+                episodes.append([])
+            episodes[-1].append(r.fields["gripper_pose"][:3])
+    keyframes = [np.array(e[-1]) for e in episodes]  # reach_target: one keyframe, the last frame
+    actions = [r.fields["pose"][:3] for r in read_stream.read_records(path("actions.rec")) if r.type == "action"]
+    if len(actions) != len(keyframes) or len(actions) != 20:
+        sys.exit(f"FAIL: {len(actions)} actions for {len(keyframes)} held-out demonstrations")
+    voxel = 2 * 0.15 / 16
+    errors = [float(np.abs(a - k).max()) for a, k in zip(actions, keyframes)]
+    hits = sum(e <= 1.5 * voxel for e in errors)
+    print("distance to the keyframe, cm (max over axes):", " ".join(f"{100 * e:.1f}" for e in errors))
+    print(f"{hits}/{len(errors)} within one final-depth voxel")
+    if hits < 0.8 * len(errors):
+        sys.exit(f"FAIL: behaviour cloning reached {hits}/{len(errors)}, expected >= 80%")
+    print("behaviour cloning ok")
+finally:
+    shutil.rmtree(tmp, ignore_errors=True)
