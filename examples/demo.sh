@@ -1,8 +1,7 @@
 #!/usr/bin/env bash
-# `make demo`: runs the toolkit's main job with the programs that exist so far, on the
-# built-in simulated tasks, and says what it did: simulation, planning, demonstrations,
-# keyframe transitions and voxel grids. The learner (qattn-train) and the agent (qte-select)
-# land with their issues; this script grows with them.
+# `make demo`: runs the toolkit's main job on the built-in simulated tasks and says what it
+# did: simulation, planning, demonstrations, keyframe transitions, voxel grids, and a short
+# but real run of the learning loop (learner, actor through a FIFO, evaluation, curve).
 set -euo pipefail
 out=${QTE_DEMO_DIR:-out/demo}
 rm -rf "$out" && mkdir -p "$out"
@@ -45,6 +44,17 @@ head -c 400 "$out/motion.jsonl" >&2; echo " ..." >&2
 stream-dump --npy "$out/npy" --type obs "$out/reach_target.rec" > /dev/null
 ls "$out/npy" >&2
 
-say "done: streams (.rec), PNG frames and .npy arrays are in $out/"
+say "6. the learning loop, short: 5 demos, 60 learner steps on them, 30 exploring steps, greedy evaluation"
+# The same loop as `make -C examples reach_target`, on a budget of about two minutes (the
+# full run is 10 demos and 2,000 environment steps). See examples/learn.sh.
+make -s -C examples reach_target RUNS="$(realpath "$out")/runs" BUILD="$(dirname "$(command -v sim-step)")/.." \
+  DEMOS=5 PRETRAIN=60 ENV_STEPS=30 EVAL_EVERY=30 CHUNK_EPISODES=5 EVAL_EPISODES=10 CHECKPOINT_EVERY=20 BATCH=16
+run=$out/runs/reach_target/qte-k10-t10-seed0
+cat "$run/eval.csv" >&2
+stream-cat --type obs --where step=0 --head 1 "$run/chunks/0000.rec" \
+  | qte-select --checkpoint "$run/ckpt/latest.rec" --k 10 --png "$out/attention" > /dev/null
+ls "$run/curve.png" "$out"/attention/*.png >&2
+
+say "done: streams (.rec), PNG frames, .npy arrays, a learning run (eval.csv, curve.png) are in $out/"
 echo "Ran: sim-step, demo-record (with plan-path's planner), keyframe, voxelize, stream-png," >&2
-echo "stream-pack, stream-cat, stream-dump. Not built yet: qattn-train, qte-select." >&2
+echo "stream-pack, stream-cat, stream-dump, qattn-train, qte-select, episode-stats, plot-curves." >&2

@@ -41,9 +41,21 @@ torch::Tensor reference_loss(const QOutputs& out) {
 }
 
 // Median seconds of `reps` training steps after one warm-up step, with the reference's loss.
+bool channels_last = false;  // --channels-last: weights and inputs in oneDNN's NDHWC layout
+
+void to_channels_last(QAttentionNet& net) {
+  torch::NoGradGuard no_grad;
+  for (auto& p : net.module().parameters())
+    if (p.dim() == 5) p.set_data(p.contiguous(torch::MemoryFormat::ChannelsLast3d));
+}
+
 double train_step_seconds(QAttentionNet& net, int batch, int reps) {
   const NetConfig& c = net.config();
-  const auto grids = torch::randn({batch, c.channels, c.voxels, c.voxels, c.voxels});
+  auto grids = torch::randn({batch, c.channels, c.voxels, c.voxels, c.voxels});
+  if (channels_last) {
+    to_channels_last(net);
+    grids = grids.contiguous(torch::MemoryFormat::ChannelsLast3d);
+  }
   const auto proprio = torch::randn({batch, c.proprio});
   torch::optim::Adam adam(net.module().parameters(), torch::optim::AdamOptions(5e-4));
   const auto step = [&] {
@@ -149,6 +161,7 @@ void export_reference_check(const std::string& dir) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  qte::nets::use_passive_openmp_waits(argv);  // fair figures while other programs run
   bool quick = false, sweep = false;
   int threads = 2;
   std::string export_dir;
@@ -157,6 +170,8 @@ int main(int argc, char** argv) {
       quick = true;
     else if (!std::strcmp(argv[i], "--sweep"))
       sweep = true;
+    else if (!std::strcmp(argv[i], "--channels-last"))
+      channels_last = true;
     else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc)
       threads = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--export") && i + 1 < argc)
@@ -173,7 +188,7 @@ int main(int argc, char** argv) {
   }
   seed_torch(0);
   std::printf("threads=%d, grid 16^3 x 10 channels, proprio 4 (arm also with the reference's 11)\n", threads);
-  if (sweep) {
+  if (sweep || channels_last) {
     for (int k : {8, 16, 24, 32}) bench(Architecture::light, k, false, false, 4);
     return 0;
   }
