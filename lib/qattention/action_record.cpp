@@ -1,0 +1,46 @@
+#include "qattention/action_record.hpp"
+
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "keyframes/keyframes.hpp"
+
+namespace qte::qattention {
+
+namespace {
+
+std::vector<double> bounds_field(const voxels::GridBounds& b) {
+  return {b.min_corner.x(), b.min_corner.y(), b.min_corner.z(), b.size_m};
+}
+
+}  // namespace
+
+stream::Record action_record(const Choice& choice, bool ignore_collisions, int k, bool explored,
+                             int64_t checkpoint_step, int32_t step) {
+  const Choice& c = choice;
+  stream::Record a("action");
+  const Eigen::Vector3d p = c.position();
+  Eigen::Quaterniond q(keyframes::rotation_from_bins(c.rotation_bins));
+  q.normalize();
+  a.set<double>("pose", {7}, std::vector<double>{p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w()});
+  a.set_scalar<uint8_t>("gripper_open", c.gripper_open ? 1 : 0);
+  a.set_scalar<uint8_t>("ignore_collisions", ignore_collisions ? 1 : 0);
+  for (std::size_t d = 0; d < c.indices.size(); ++d) {
+    const std::string prefix = "depth" + std::to_string(d);
+    a.set<int32_t>(prefix + ".index", {3}, c.indices[d].data());
+    a.set<double>(prefix + ".bounds", {4}, bounds_field(c.bounds[d]));
+    const Eigen::Vector3d centre = c.bounds[d].centre_of(c.indices[d]);
+    a.set<double>(prefix + ".centre", {3}, centre.data());
+    a.set_scalar<float>(prefix + ".q_value", c.q_values[d]);
+  }
+  a.set<int32_t>("rotation_bins", {3}, c.rotation_bins.data());
+  a.set_scalar<float>("value", c.value);
+  a.set_scalar<int32_t>("k", k);
+  a.set_scalar<uint8_t>("explored", explored ? 1 : 0);
+  a.set_scalar<int64_t>("checkpoint_step", checkpoint_step);
+  a.set_scalar<int32_t>("step", step);
+  return a;
+}
+
+}  // namespace qte::qattention
