@@ -92,6 +92,7 @@ static cli::Usage usage() {
       {"q-reg", "L", "lambda of the lambda * mean|Q| regularisation", "1"},
       {"huber-delta", "D", "Huber loss threshold", "1"},
       {"tree-target", "K", "bootstrap with tree expansion of K branches per depth (0: double DQN)", "0"},
+      {"n-step", "N", "bootstrap after N transitions of a chain, summing their discounted rewards", "1"},
       {"uniform", "", "uniform replay sampling instead of prioritised", ""},
       {"alpha", "A", "priority exponent", "0.7"},
       {"beta", "B", "importance-weight exponent", "1"},
@@ -164,6 +165,7 @@ static void run(const cli::Arguments& args) {
   config.q_regularisation = args.real("q-reg");
   config.huber_delta = args.real("huber-delta");
   config.tree_target_k = static_cast<int>(args.integer("tree-target"));
+  config.n_step = static_cast<int>(args.integer("n-step"));
   config.validate();
   if (!args.has("checkpoint-dir")) throw UsageError("--checkpoint-dir is required");
   const int64_t total_steps = args.integer("steps"), start_after = args.integer("start-after");

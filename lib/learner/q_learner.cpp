@@ -41,7 +41,9 @@ std::string LearnerConfig::json() const {
     << "], \"batch\": " << batch << ", \"gamma\": " << gamma << ", \"reward_scale\": " << reward_scale
     << ", \"tau\": " << tau << ", \"learning_rate\": " << learning_rate << ", \"weight_decay\": " << weight_decay
     << ", \"grad_clip\": " << grad_clip << ", \"q_regularisation\": " << q_regularisation
-    << ", \"huber_delta\": " << huber_delta << ", \"tree_target_k\": " << tree_target_k << "}";
+    << ", \"huber_delta\": " << huber_delta << ", \"tree_target_k\": " << tree_target_k;
+  if (n_step != 1) s << ", \"n_step\": " << n_step;  // absent for 1: checkpoints of 1-step runs stay valid
+  s << "}";
   return s.str();
 }
 
@@ -54,6 +56,7 @@ void LearnerConfig::validate() const {
       !(reward_scale > 0))
     throw UsageError("--weight-decay, --grad-clip and --q-reg must be >= 0; --huber-delta, --reward-scale > 0");
   if (tree_target_k < 0) throw UsageError("--tree-target must be >= 0");
+  if (n_step < 1 || n_step > 10) throw UsageError("--n-step must be 1-10");
   if (hierarchy.depths < 1 || hierarchy.depths > 8) throw UsageError("--depths must be 1-8");
 }
 
@@ -109,17 +112,33 @@ Minibatch assemble_minibatch(const replay::ReplayBuffer& replay, const replay::S
       b.voxel[d][i] = (static_cast<int64_t>(index3[0]) * v + index3[1]) * v + index3[2];
       voxels::voxelize(cloud.view(), g, b.grids[d].data() + i * grid_floats);
     }
-    const int step = t.scalar<int32_t>("step");
-    const std::vector<float> p = qattention::proprio_of(frame, step);
+    const std::vector<float> p = qattention::proprio_of(frame, t.scalar<int32_t>("step"));
     b.proprio.insert(b.proprio.end(), p.begin(), p.end());
     const auto bins = t.array<int32_t>("rotation_bins");
     for (int axis = 0; axis < 3; ++axis) b.rotation_bins.push_back(bins[axis]);
     b.gripper.push_back(t.scalar<uint8_t>("gripper_open") != 0 ? 1 : 0);
-    b.reward.push_back(t.scalar<float>("reward"));
-    b.discount.push_back(t.scalar<uint8_t>("terminal") != 0 ? 0.0f : static_cast<float>(config.gamma));
-    const stream::Record& next = replay.next_frame_of(index);
+    // The n-step return: rewards along the chain until it ends or n transitions are summed,
+    // then the discounted value of the observation reached.
+    std::size_t last = index;
+    double reward = 0, discount = 1;
+    for (int n = 0; n < config.n_step; ++n) {
+      const stream::Record& u = replay.transition(last);
+      reward += discount * u.scalar<float>("reward");
+      discount *= config.gamma;
+      if (u.scalar<uint8_t>("terminal") != 0) {
+        discount = 0;
+        break;
+      }
+      if (n + 1 == config.n_step) break;
+      const std::optional<std::size_t> successor = replay.successor_of(last);
+      if (!successor) break;
+      last = *successor;
+    }
+    b.reward.push_back(static_cast<float>(reward));
+    b.discount.push_back(static_cast<float>(discount));
+    const stream::Record& next = replay.next_frame_of(last);
     b.next_clouds.push_back(voxels::observation_cloud(next));
-    b.next_proprio.push_back(qattention::proprio_of(next, step + 1));
+    b.next_proprio.push_back(qattention::proprio_of(next, replay.transition(last).scalar<int32_t>("step") + 1));
   }
   return b;
 }

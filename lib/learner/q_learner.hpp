@@ -35,6 +35,7 @@ struct LearnerConfig {
   double q_regularisation = 1.0;   // λ of λ·mean|Q|
   double huber_delta = 1.0;
   int tree_target_k = 0;           // 0: double DQN; K >= 1: tree expansion over the target network
+  int n_step = 1;                  // bootstrap after n transitions of a chain (the n-step return)
 
   // The settings a resumed run must share with its checkpoint, as JSON.
   std::string json() const;
@@ -49,8 +50,8 @@ struct Minibatch {
   std::vector<std::vector<int64_t>> voxel;  // per depth: the action's voxel, flat (x, y, z order)
   std::vector<int64_t> rotation_bins;       // [B, 3]
   std::vector<int64_t> gripper;             // [B]: 1 = open (the gripper head's index)
-  std::vector<float> reward;                // as stored (100 on success)
-  std::vector<float> discount;              // gamma, or 0 when the transition is terminal
+  std::vector<float> reward;                // as stored (100 on success); the discounted sum over n steps
+  std::vector<float> discount;              // gamma^n, or 0 when the chain ends within n steps
   std::vector<voxels::ObservationCloud> next_clouds;
   std::vector<std::vector<float>> next_proprio;
   std::vector<double> weights;              // importance weights

@@ -46,11 +46,14 @@ bool ReplayBuffer::add(const stream::Record& record) {
     }
     slot = next_evicted_;
     next_evicted_ = (next_evicted_ + 1) % transitions_.size();
+    const auto acting = acting_on_.find(transitions_[slot].frame);
+    if (acting != acting_on_.end() && acting->second == slot) acting_on_.erase(acting);
     release(transitions_[slot].frame);
     release(transitions_[slot].next_frame);
     demos_ -= transitions_[slot].demo;
   }
   demos_ += stored.demo;
+  acting_on_[stored.frame] = slot;
   if (slot == transitions_.size()) transitions_.push_back(std::move(stored));
   else transitions_[slot] = std::move(stored);
   tree_.set(slot, options_.prioritised ? tree_.max() : 1.0);  // new: sampled at least once soon
@@ -118,6 +121,12 @@ const stream::Record& ReplayBuffer::frame_of(std::size_t index) const {
 
 const stream::Record& ReplayBuffer::next_frame_of(std::size_t index) const {
   return frames_.at(transitions_.at(index).next_frame).first;
+}
+
+std::optional<std::size_t> ReplayBuffer::successor_of(std::size_t index) const {
+  const auto found = acting_on_.find(transitions_.at(index).next_frame);
+  if (found == acting_on_.end()) return std::nullopt;
+  return found->second;
 }
 
 }  // namespace qte::replay

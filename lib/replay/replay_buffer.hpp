@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -50,6 +51,9 @@ class ReplayBuffer {
   // The observation a transition acts on, and the one it reaches.
   const stream::Record& frame_of(std::size_t index) const;
   const stream::Record& next_frame_of(std::size_t index) const;
+  // The transition that continues `index`'s chain (acting on the observation it reaches), if
+  // the replay holds one: what n-step returns follow.
+  std::optional<std::size_t> successor_of(std::size_t index) const;
 
  private:
   using FrameKey = std::pair<int64_t, int32_t>;  // (episode_key, frame)
@@ -63,6 +67,7 @@ class ReplayBuffer {
   ReplayOptions options_;
   std::vector<Stored> transitions_;
   std::map<FrameKey, std::pair<stream::Record, int>> frames_;  // frame and its reference count
+  std::map<FrameKey, std::size_t> acting_on_;  // the newest transition acting on each frame
   SumTree tree_;
   std::size_t demos_ = 0;
   std::size_t next_evicted_ = 0;  // ring position among the agent's transitions

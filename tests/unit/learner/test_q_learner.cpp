@@ -252,3 +252,29 @@ TEST(QLearner, NonFiniteLossStopsBeforeAnyWeightChanges) {
   EXPECT_EQ(flat_parameters(learner.online()), before);
   EXPECT_EQ(learner.step(), 0);
 }
+
+TEST(QLearner, NStepReturnsFollowTheChain) {
+  learner::LearnerConfig config = small_config();
+  replay::ReplayBuffer replay;
+  const Eigen::Vector3f block(0.1f, -0.2f, 0.78f);
+  for (int32_t f = 0; f < 3; ++f) replay.add(frame(9, f, block, 220));
+  stream::Record first = transition(config.hierarchy, 9, {0.1, -0.2, 0.8}, false);
+  stream::Record second = transition(config.hierarchy, 9, {0.1, -0.2, 0.8}, true);
+  second.set_scalar<int32_t>("frame", 1);
+  second.set_scalar<int32_t>("next_frame", 2);
+  second.set_scalar<int32_t>("step", 1);
+  replay.add(first);
+  replay.add(second);
+  ASSERT_EQ(replay.successor_of(0), std::optional<std::size_t>(1));
+  EXPECT_FALSE(replay.successor_of(1).has_value());
+
+  const replay::Sample just_first{{0}, {1.0}};
+  const learner::Minibatch one = learner::assemble_minibatch(replay, just_first, config);
+  EXPECT_FLOAT_EQ(one.reward[0], 0);
+  EXPECT_FLOAT_EQ(one.discount[0], 0.99f);
+  config.n_step = 3;  // the chain ends after two: 0 + 0.99 * 100, nothing to bootstrap from
+  const learner::Minibatch three = learner::assemble_minibatch(replay, just_first, config);
+  EXPECT_FLOAT_EQ(three.reward[0], 99.0f);
+  EXPECT_FLOAT_EQ(three.discount[0], 0);
+  EXPECT_FLOAT_EQ(three.next_proprio[0][3], 1.0f - 2.0f * 2 / 9);  // the observation after step 1
+}
