@@ -52,6 +52,8 @@ struct QValues {
 
 class QAttentionModule;  // the torch module (nets/qattention_modules.hpp)
 
+constexpr int kPredictChunk = 32;
+
 class QAttentionNet {
  public:
   // Fresh weights drawn from torch's generator: call seed_torch() first to reproduce them.
@@ -64,7 +66,8 @@ class QAttentionNet {
   int64_t parameter_count() const;
 
   // Inference without gradients. `grids`: [batch, voxels, voxels, voxels, channels], channels
-  // last as voxels::voxelize writes them; `proprio`: [batch, proprio].
+  // last as voxels::voxelize writes them; `proprio`: [batch, proprio]. Evaluated in chunks of
+  // kPredictChunk samples.
   QValues predict(const float* grids, const float* proprio, int batch) const;
 
   QAttentionModule& module() { return *module_; }
