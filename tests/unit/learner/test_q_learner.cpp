@@ -146,7 +146,7 @@ TEST(QLearner, OverfitsATinyFixedReplay) {
   replay::ReplayBuffer replay = tiny_replay(config);
   const learner::Minibatch batch = learner::assemble_minibatch(replay, all_of(replay), config);
   double first = 0, last = 0;
-  for (int step = 0; step < 150; ++step) {
+  for (int step = 0; step < 100; ++step) {
     const learner::StepStats stats = learner.train_step(batch);
     double td = 0;
     for (double e : stats.td_errors) td += e / stats.td_errors.size();
@@ -154,7 +154,7 @@ TEST(QLearner, OverfitsATinyFixedReplay) {
     last = td;
   }
   EXPECT_GT(first, 0.3);
-  EXPECT_LT(last, 0.05) << "mean |TD error| after 150 steps (first step: " << first << ")";
+  EXPECT_LT(last, 0.05) << "mean |TD error| after 100 steps (first step: " << first << ")";
 }
 
 TEST(QLearner, TargetNetworkFollowsTau) {
