@@ -113,11 +113,6 @@ static cli::Usage usage() {
 
 namespace {
 
-struct Metrics {
-  std::string path;
-  std::ofstream out;
-};
-
 std::string csv_header(int depths) {
   std::string h = "step,transitions,agent_transitions,replay,demos,loss";
   for (int d = 0; d < depths; ++d) h += ",loss_d" + std::to_string(d);

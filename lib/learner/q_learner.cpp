@@ -97,8 +97,7 @@ Minibatch assemble_minibatch(const replay::ReplayBuffer& replay, const replay::S
   b.voxel.assign(depths, std::vector<int64_t>(b.size));
   for (int i = 0; i < b.size; ++i) {
     const std::size_t index = sample.indices[i];
-    const stream::Record& t = replay.transition(index);
-    check_transition(t, config);
+    const stream::Record& t = replay.transition(index);  // checked when read (check_transition)
     const stream::Record& frame = replay.frame_of(index);
     const voxels::ObservationCloud cloud = voxels::observation_cloud(frame);
     std::vector<voxels::GridBounds> grids;

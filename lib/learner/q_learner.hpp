@@ -58,13 +58,14 @@ struct Minibatch {
   std::vector<std::size_t> indices;         // replay indices
 };
 
-// Voxelizes the sampled transitions' frames. Throws StreamError naming a transition made for
-// another voxel count or depth count than `config`.
+// Voxelizes the sampled transitions' frames. The transitions must have passed
+// check_transition when they were read (it is not repeated for every sample).
 Minibatch assemble_minibatch(const replay::ReplayBuffer& replay, const replay::Sample& sample,
                              const LearnerConfig& config);
 
-// Checks one transition against the learner's settings (what assemble_minibatch checks), so a
-// wrong input is refused when it is read rather than when it is first sampled.
+// Checks one transition against the learner's settings (voxel count, depth count, index and
+// bin ranges, a finite reward): call it on every transition as it is read, so a wrong input is
+// refused with its position before it can reach a minibatch.
 void check_transition(const stream::Record& transition, const LearnerConfig& config);
 
 struct StepStats {

@@ -11,6 +11,7 @@
 
 #include "common/error.hpp"
 #include "qattention/acting.hpp"
+#include "random_cloud.hpp"
 
 using namespace qte;
 using namespace qte::qattention;
@@ -19,18 +20,8 @@ namespace {
 
 constexpr int V = 16, kCells = V * V * V;
 
-struct Cloud {
-  std::vector<float> xyz;
-  std::vector<uint8_t> rgb;
-  Cloud() {
-    std::mt19937 rng(2);
-    std::uniform_real_distribution<float> u(0, 1);
-    for (int i = 0; i < 2000; ++i) {
-      xyz.insert(xyz.end(), {-0.3f + u(rng), -0.5f + u(rng), 0.6f + u(rng)});
-      rgb.insert(rgb.end(), {40, 160, 90});
-    }
-  }
-  voxels::PointCloud view() const { return {xyz.data(), rgb.data(), rgb.size() / 3}; }
+struct Cloud : test_support::RandomCloud {
+  Cloud() : RandomCloud(2, {40, 160, 90}) {}
 };
 
 // Q from a voxel's mean point (-1 when empty), rotation and gripper at the last of two depths;

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "qattention/exploration.hpp"
+#include "random_cloud.hpp"
 
 using namespace qte;
 using namespace qte::qattention;
@@ -15,18 +16,8 @@ namespace {
 
 constexpr int V = 16, kCells = V * V * V;
 
-struct Cloud {
-  std::vector<float> xyz;
-  std::vector<uint8_t> rgb;
-  Cloud() {
-    std::mt19937 rng(1);
-    std::uniform_real_distribution<float> u(0, 1);
-    for (int i = 0; i < 2000; ++i) {
-      xyz.insert(xyz.end(), {-0.3f + u(rng), -0.5f + u(rng), 0.6f + u(rng)});
-      rgb.insert(rgb.end(), {120, 80, 40});
-    }
-  }
-  voxels::PointCloud view() const { return {xyz.data(), rgb.data(), rgb.size() / 3}; }
+struct Cloud : test_support::RandomCloud {
+  Cloud() : RandomCloud(1, {120, 80, 40}) {}
 };
 
 // A stand-in for the networks (this tests exploration, not them): Q from a voxel's mean point,
