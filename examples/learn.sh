@@ -19,6 +19,7 @@ task=$1 run=$2
 : "${ENV_STEPS:=2000}" "${CHUNK_EPISODES:=10}" "${EVAL_EVERY:=250}" "${EVAL_EPISODES:=50}" "${EVAL_SEED:=1000000}"
 : "${ARCH:=light}" "${BATCH:=32}" "${RATIO:=0.5}" "${PRETRAIN:=200}" "${START_AFTER:=0}"
 : "${LEARNER_THREADS:=1}" "${EPSILON:=0.1}" "${ROTATION_NOISE:=1}" "${CHECKPOINT_EVERY:=25}" "${LABEL:=k$ACT_K-$TARGET_K}"
+: "${N_STEP:=1}"
 mkdir -p "$run/chunks" "$run/eval"
 log() { printf '%s %s\n' "$(date +%H:%M:%S)" "$*" >&2; }
 
@@ -35,7 +36,7 @@ fi
 rm -f "$run/actor.done"
 qattn-train --follow --resume --stop-file "$run/actor.done" --replay-ratio "$RATIO" --pretrain "$PRETRAIN" \
   --start-after "$START_AFTER" --steps 1000000 --checkpoint-every "$CHECKPOINT_EVERY" --keep 4 \
-  --architecture "$ARCH" --batch "$BATCH" --tree-target "$TARGET_K" --seed "$SEED" --threads "$LEARNER_THREADS" \
+  --architecture "$ARCH" --batch "$BATCH" --tree-target "$TARGET_K" --n-step "$N_STEP" --seed "$SEED" --threads "$LEARNER_THREADS" \
   --checkpoint-dir "$run/ckpt" --metrics "$run/train.csv" "$run/replay.rec" 2>> "$run/train.log" &
 learner=$!
 trap 'kill $learner 2>/dev/null || true' EXIT

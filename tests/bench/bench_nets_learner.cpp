@@ -7,10 +7,14 @@
 // The reference's bare network step (forward + backward + Adam at one depth, no data) is
 // printed by /usr/bin/python3 shared/bench/torch_qattention_ref.py 2; run it back to back.
 // Options: --arch light|arm, --batch B, --tree-target K, --steps N, --threads N.
+//   --compare K: instead, full steps with plain (double-DQN) and tree-expanded (K) targets,
+//   each with denormals flushed (as shipped) and with IEEE denormals, interleaved step by
+//   step so that a noisy machine hits all four alike; prints the ratios.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -33,7 +37,7 @@ static double median(std::vector<double> v) {
 int main(int argc, char** argv) {
   qte::nets::use_passive_openmp_waits(argv);  // fair figures while other programs run
   std::string arch = "light";
-  int batch = 32, tree = 0, steps = 5, threads = 2;
+  int batch = 32, tree = 0, steps = 5, threads = 2, compare = 0;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     if (a == "--arch") arch = argv[i + 1];
@@ -41,6 +45,7 @@ int main(int argc, char** argv) {
     else if (a == "--tree-target") tree = std::atoi(argv[i + 1]);
     else if (a == "--steps") steps = std::atoi(argv[i + 1]);
     else if (a == "--threads") threads = std::atoi(argv[i + 1]);
+    else if (a == "--compare") compare = std::atoi(argv[i + 1]);
   }
   nets::set_torch_threads(threads);
   nets::seed_torch(1);
@@ -61,6 +66,40 @@ int main(int argc, char** argv) {
                       [](const std::string&) {});
   converter.finish();
   std::printf("replay: %zu transitions, %zu frames (10 pick_and_lift demos)\n", replay.size(), replay.frame_count());
+
+  if (compare > 0) {
+    struct Variant {
+      const char* name;
+      int tree;
+      bool flush;
+      std::unique_ptr<learner::QLearner> learner;
+      std::vector<double> seconds;
+    };
+    std::vector<Variant> variants;
+    for (bool flush : {true, false})
+      for (int k : {0, compare}) {
+        learner::LearnerConfig c = config;
+        c.tree_target_k = k;
+        nets::seed_torch(1);
+        variants.push_back({k == 0 ? "plain targets" : "tree targets", k, flush,
+                            std::make_unique<learner::QLearner>(c), {}});
+      }
+    for (int step = 0; step <= steps; ++step)  // step 0 warms up
+      for (Variant& v : variants) {
+        nets::flush_denormals(v.flush);
+        std::mt19937_64 rng(step);
+        const auto t0 = Clock::now();
+        const replay::Sample sample = replay.sample(batch, 1.0, rng);
+        v.learner->train_step(learner::assemble_minibatch(replay, sample, config));
+        if (step > 0) v.seconds.push_back(since(t0));
+      }
+    std::printf("%s batch %d, %d threads, full steps interleaved, median of %d:\n", arch.c_str(), batch, threads, steps);
+    for (const Variant& v : variants)
+      std::printf("  %-14s K=%-2d %-17s %.3f s  (%.2fx plain, %s)\n", v.name, v.tree,
+                  v.flush ? "denormals flushed" : "IEEE denormals", median(v.seconds),
+                  median(v.seconds) / median(variants[v.flush ? 0 : 2].seconds), v.flush ? "shipped" : "not shipped");
+    return 0;
+  }
 
   learner::QLearner learner(config);
   std::vector<double> sample_s, assemble_s, target_s, full_s;
