@@ -51,13 +51,16 @@ wait_for_learner() {
   while [ "$(learner_step)" -lt "$want" ]; do kill -0 $learner || { tail -2 "$run/train.log"; exit 1; }; sleep 1; done
 }
 # Greedy episodes of one checkpoint on the held-out seeds -> one CSV row.
-evaluate() {  # CHECKPOINT ENV_STEPS OUT.csv LEARNER_STEP
+# eval_point: the budget the evaluation stands for (0, EVAL_EVERY, ..., ENV_STEPS); env_steps
+# (what the actor had taken, up to a chunk more) varies between seeds, eval_point does not.
+evaluate() {  # CHECKPOINT ENV_STEPS OUT.csv LEARNER_STEP EVAL_POINT
   local fifo; fifo=$(mktemp -u); mkfifo "$fifo"
   sim-step --task "$task" --variation "$VARIATION" --episodes "$EVAL_EPISODES" --seed "$EVAL_SEED" \
     --image-size "$IMAGE" < "$fifo" \
     | qte-select --checkpoint "$1" --k "$ACT_K" --threads 1 \
     | plan-path | tee "$fifo" \
     | episode-stats --label "$LABEL" --column seed="$SEED" --column env_steps="$2" --column train_step="$4" \
+        --column eval_point="$5" \
         > "$3.tmp"
   rm -f "$fifo"
   mv "$3.tmp" "$3"
@@ -73,7 +76,7 @@ while :; do
     wait_for_learner "$env_steps"
     snapshot=$run/eval/checkpoint.rec
     until step=$(learner_step) && cp "$run/ckpt/step-$(printf '%08d' "$step").rec" "$snapshot" 2>/dev/null; do sleep 0.2; done
-    evaluate "$snapshot" "$env_steps" "$eval_csv" "$step"
+    evaluate "$snapshot" "$env_steps" "$eval_csv" "$step" $(( mark == 999999 ? ENV_STEPS : mark * EVAL_EVERY ))
     log "$task $LABEL seed $SEED: env steps $env_steps, learner step $step: $(tail -1 "$eval_csv")"
   fi
   [ "$env_steps" -ge "$ENV_STEPS" ] && break
