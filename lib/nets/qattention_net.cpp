@@ -1,9 +1,6 @@
 #include "nets/qattention_net.hpp"
 
 #include <unistd.h>
-#if defined(__SSE__)
-#include <xmmintrin.h>
-#endif
 
 #include <algorithm>
 #include <cstdlib>
@@ -98,23 +95,6 @@ void use_passive_openmp_waits(char** argv) {
 void set_torch_threads(int threads) {
   if (threads < 1) throw Error("torch threads must be >= 1, got " + std::to_string(threads));
   torch::set_num_threads(threads);
-  flush_denormals();
-}
-
-void flush_denormals(bool flush) {
-#if defined(__SSE__)
-  constexpr unsigned kFlushToZero = 0x8000, kDenormalsAreZero = 0x0040;  // MXCSR bits
-  const auto set = [flush] {
-    const unsigned csr = _mm_getcsr();
-    _mm_setcsr(flush ? csr | kFlushToZero | kDenormalsAreZero : csr & ~(kFlushToZero | kDenormalsAreZero));
-  };
-  set();
-  // One index per thread: ATen's OpenMP parallel_for gives each thread one contiguous chunk.
-  const int64_t threads = torch::get_num_threads();
-  at::parallel_for(0, threads, 1, [&](int64_t, int64_t) { set(); });
-#else
-  (void)flush;
-#endif
 }
 
 }  // namespace qte::nets

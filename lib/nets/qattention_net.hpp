@@ -83,15 +83,8 @@ std::vector<QAttentionNet> make_coarse_to_fine_nets(NetConfig config, int depths
 
 // Seeds torch's CPU generator: the same seed gives the same initial weights.
 void seed_torch(uint64_t seed);
-// Intra-op threads of LibTorch (its default is every core); also flushes denormals on them.
+// Intra-op threads of LibTorch (its default is every core).
 void set_torch_threads(int threads);
-
-// Denormal floats flushed to zero (FTZ + DAZ) on the calling thread and on every LibTorch
-// thread. The soft-argmax of the last depth's head takes a sharp softmax whose tails underflow
-// through the denormal range, where the CPU slows down by orders of magnitude; measured: the
-// softmax 3x and the last depth's inference 1.4x faster (bench_nets_predict). Results change
-// only where a value would have been below 1.2e-38. `flush` false restores IEEE behaviour.
-void flush_denormals(bool flush = true);
 
 // LibTorch's OpenMP threads spin while they wait for work. When two programs share the cores
 // (the learner and the actor of the learning loop on 2 cores), a spinning thread takes the

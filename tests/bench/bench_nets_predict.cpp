@@ -2,8 +2,7 @@
 // targets multiply: B (1 + K) grids per step. Compares, interleaved in one run so that a noisy
 // machine hits every variant alike: QAttentionNet::predict as shipped, and the module's forward
 // with the input and weights in NCDHW or NDHWC (channels-last, oneDNN's preferred layout and
-// our grids' native one), in chunks of 16, 32, 64 samples, under NoGradGuard or InferenceMode,
-// with denormals flushed to zero or not (nets::flush_denormals).
+// our grids' native one), in chunks of 16, 32, 64 samples, under NoGradGuard or InferenceMode.
 //
 // Options: --arch light|arm, --grids N (default 352 = 32 x (1 + 10)), --threads N (default 1),
 //          --reps N (default 5), --last (the last depth's network, with the dense head).
@@ -12,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -87,24 +87,13 @@ int main(int argc, char** argv) {
       }
     };
   };
-  // Each variant sets the denormal mode it is measured with (the shipped one flushes).
-  const auto with_denormals = [](bool flush, std::function<void()> run) {
-    return [flush, run] {
-      flush_denormals(flush);
-      run();
-    };
-  };
   std::vector<Variant> variants;
-  const auto shipped_predict = [&] { shipped.predict(data.data(), proprio.data(), grids); };
-  variants.push_back({"predict (shipped, denormals flushed)", with_denormals(true, shipped_predict), {}});
-  variants.push_back({"predict, IEEE denormals", with_denormals(false, shipped_predict), {}});
-  for (int chunk : {16, 64}) {
-    variants.push_back({"NCDHW chunk " + std::to_string(chunk), with_denormals(true, chunked(nchw, chunk, false, false)), {}});
-  }
-  for (int chunk : {16, 32}) {
-    variants.push_back({"NDHWC chunk " + std::to_string(chunk), with_denormals(true, chunked(nhwc, chunk, true, false)), {}});
-  }
-  variants.push_back({"NCDHW chunk 32 inference mode", with_denormals(true, chunked(nchw, 32, false, true)), {}});
+  variants.push_back({"predict (shipped)", [&] { shipped.predict(data.data(), proprio.data(), grids); }, {}});
+  for (int chunk : {16, 64})
+    variants.push_back({"NCDHW chunk " + std::to_string(chunk), chunked(nchw, chunk, false, false), {}});
+  for (int chunk : {16, 32})
+    variants.push_back({"NDHWC chunk " + std::to_string(chunk), chunked(nhwc, chunk, true, false), {}});
+  variants.push_back({"NCDHW chunk 32 inference mode", chunked(nchw, 32, false, true), {}});
   for (auto& variant : variants) variant.run();  // warm-up
   for (int r = 0; r < reps; ++r)
     for (auto& variant : variants) {
