@@ -10,6 +10,10 @@
 #   sim-step | qte-select (greedy) | plan-path | episode-stats
 #                                               evaluation on held-out seeds after each chunk
 #
+# Scenes: demonstrations, exploration and evaluation come from disjoint scene sets by
+# construction (--scenes demo / explore / eval); the evaluation scenes are the same for every
+# SEED, so seeds and methods are compared on one held-out set.
+#
 # Usage: learn.sh TASK RUN_DIR   (settings from the environment; see examples/Makefile)
 # Resumable: finished chunks and evaluations are kept, the learner resumes from its last
 # checkpoint; an interrupted chunk is run again (its finished episodes stay in the replay).
@@ -26,7 +30,7 @@ log() { printf '%s %s\n' "$(date +%H:%M:%S)" "$*" >&2; }
 # 1. Demonstrations -> transitions (once; written under a temporary name, then renamed).
 if [ ! -f "$run/replay.rec" ]; then
   log "$task: $DEMOS demonstrations"
-  demo-record --task "$task" --episodes "$DEMOS" --seed "$SEED" --variation "$VARIATION" --image-size "$IMAGE" \
+  demo-record --task "$task" --episodes "$DEMOS" --seed "$SEED" --scenes demo --variation "$VARIATION" --image-size "$IMAGE" \
     --compress --output "$run/demos.rec" 2>> "$run/demos.log"
   keyframe --seed "$SEED" --output "$run/replay.rec.tmp" "$run/demos.rec" 2>> "$run/demos.log"
   mv "$run/replay.rec.tmp" "$run/replay.rec"
@@ -55,7 +59,7 @@ wait_for_learner() {
 # (what the actor had taken, up to a chunk more) varies between seeds, eval_point does not.
 evaluate() {  # CHECKPOINT ENV_STEPS OUT.csv LEARNER_STEP EVAL_POINT
   local fifo; fifo=$(mktemp -u); mkfifo "$fifo"
-  sim-step --task "$task" --variation "$VARIATION" --episodes "$EVAL_EPISODES" --seed "$EVAL_SEED" \
+  sim-step --task "$task" --variation "$VARIATION" --episodes "$EVAL_EPISODES" --seed "$EVAL_SEED" --scenes eval \
     --image-size "$IMAGE" < "$fifo" \
     | qte-select --checkpoint "$1" --k "$ACT_K" --threads 1 \
     | plan-path | tee "$fifo" \
@@ -86,6 +90,7 @@ while :; do
   if [ ! -f "$name.rec" ]; then
     fifo=$(mktemp -u); mkfifo "$fifo"
     sim-step --task "$task" --variation "$VARIATION" --episodes "$CHUNK_EPISODES" --seed $((SEED * 100000 + chunk)) \
+      --scenes explore \
       --image-size "$IMAGE" --compress < "$fifo" \
       | qte-select --checkpoint "$run/ckpt/latest.rec" --reload --k "$ACT_K" --epsilon "$EPSILON" \
           --rotation-noise "$ROTATION_NOISE" --seed $((SEED * 100000 + chunk)) --threads 1 2>> "$run/actor.log" \

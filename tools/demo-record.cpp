@@ -25,6 +25,8 @@ static cli::Usage usage() {
       {"task", "T", "reach_target, pick_and_lift or lift_numbered_block", ""},
       {"episodes", "N", "number of demonstrations", "10"},
       {"variation", "V", "task variation, or 'random' for one per episode", "0"},
+      {"scenes", "SET", "the scene set episodes are drawn from: demo (disjoint from sim-step's explore and eval "
+                        "scenes for every --seed), explore, eval or any", "demo"},
       {"retries", "N", "new seeds to try for an episode whose expert failed", "0"},
       {"cameras", "LIST", "comma-separated cameras: front, wrist, overhead", "front"},
       {"image-size", "WxH", "camera resolution", "128x128"},
@@ -51,6 +53,7 @@ static void run(const cli::Arguments& args) {
   options.episodes.episodes = static_cast<int>(args.integer("episodes"));
   options.episodes.variation = args.text("variation") == "random" ? -1 : static_cast<int>(args.integer("variation"));
   options.episodes.seed = args.seed();
+  options.episodes.scenes = simulator::scene_set_from_name(args.text("scenes"));
   options.retries = static_cast<int>(args.integer("retries"));
   options.planner.time_budget_s = args.real("time-budget");
   options.planner.seed = args.seed();

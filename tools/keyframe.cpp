@@ -44,7 +44,7 @@ static cli::Usage usage() {
       {"every", "N", "start a demo-augmentation chain at every N-th frame; 0 for none", "10"},
       {"voxels", "V", "voxels per side at every depth", "16"},
       {"depths", "D", "coarse-to-fine depths", "2"},
-      {"offset", "M", "half edge of the grids below depth 0, metres", "0.15"},
+      {"offset", "M[,M...]", "half edge of the grids of each depth below 0, metres (one per depth: 0.15,0.05 for 3)", "0.15"},
       {"bounds", "X,Y,Z,S", "scene bounds: minimum corner and edge length, metres", "-0.3,-0.5,0.6,1.0"},
       {"no-crop-augmentation", "", "use the unshifted centres for the deeper grids", ""},
       {"keep-failed", "", "also convert unsuccessful episodes (reward 0 throughout)", ""},
@@ -69,14 +69,13 @@ static void run(const cli::Arguments& args) {
   options.augmentation_every_n = static_cast<int>(args.integer("every"));
   options.hierarchy.scene = voxels::GridBounds::parse(args.text("bounds"), static_cast<int>(args.integer("voxels")));
   options.hierarchy.depths = static_cast<int>(args.integer("depths"));
-  options.hierarchy.offset_m = args.real("offset");
+  options.hierarchy.offsets_m = voxels::CoarseToFine::parse_offsets(args.text("offset"), options.hierarchy.depths);
   options.crop_augmentation = !args.flag("no-crop-augmentation");
   options.keep_failed = args.flag("keep-failed");
   options.demo = !args.flag("not-demo");
   options.seed = args.seed();
-  if (options.augmentation_every_n < 0 || options.hierarchy.depths < 1 || options.hierarchy.scene.voxels < 2 ||
-      !(options.hierarchy.offset_m > 0))
-    throw UsageError("--every >= 0, --depths >= 1, --voxels >= 2 and --offset > 0");
+  if (options.augmentation_every_n < 0 || options.hierarchy.depths < 1 || options.hierarchy.scene.voxels < 2)
+    throw UsageError("--every >= 0, --depths >= 1 and --voxels >= 2");
 
   stream::WriteOptions write_options;
   if (args.flag("append")) write_options.mode = stream::WriteMode::append;

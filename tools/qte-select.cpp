@@ -8,6 +8,7 @@
 #include <random>
 
 #include "cli/command.hpp"
+#include "voxels/grid_fields.hpp"
 #include "common/random.hpp"
 #include "nets/qattention_net.hpp"
 #include "qattention/acting.hpp"
@@ -29,10 +30,12 @@ static cli::Usage usage() {
       "'action' record: the next-best gripper pose for plan-path (pose, gripper_open, "
       "ignore_collisions) and what chose it: per depth the voxel, its grid's bounds, its centre "
       "and its Q-value; the rotation bins; the tree's value; the checkpoint's training step.",
-      "The networks, one per depth, come from --checkpoint. The observation's point cloud (every "
+      "The networks, one per depth, come from --checkpoint, with the scene bounds and offsets "
+      "they were trained on (a learner's checkpoint keeps them; --bounds and --offset that "
+      "differ are refused). The observation's point cloud (every "
       "camera's points, or points rebuilt from depth; pixels without a return are ignored) is "
-      "voxelized at depth 0 over --bounds, and at each deeper depth over the cube of centre +- "
-      "--offset around a voxel chosen above. Tree expansion keeps the --k best voxels of every "
+      "voxelized at depth 0 over the bounds, and at each deeper depth d over the cube of "
+      "centre +- offset d around a voxel chosen above. Tree expansion keeps the --k best voxels of every "
       "non-leaf grid and expands each: all the grids of a depth are voxelized in one pass over "
       "the cloud and evaluated in one batched forward. A branch is worth (its voxel's Q + the "
       "value of the best branch below it) / 2, a last-depth grid its largest Q, and the agent "
@@ -63,8 +66,8 @@ static cli::Usage usage() {
       {"k", "K", "voxels expanded per non-leaf grid; 1 is C2F-ARM's greedy choice", "10"},
       {"voxels", "V", "voxels per side of every grid (default: the checkpoint's; must agree with it)", ""},
       {"depths", "D", "coarse-to-fine depths (default: the checkpoint's; must agree with it)", ""},
-      {"bounds", "X,Y,Z,S", "scene bounds: minimum corner and edge length in metres", "-0.3,-0.5,0.6,1.0"},
-      {"offset", "M", "half edge of the deeper grids, metres", "0.15"},
+      {"bounds", "X,Y,Z,S", "scene bounds: minimum corner and edge length in metres (default: the checkpoint's, else -0.3,-0.5,0.6,1.0); must agree with the checkpoint's", ""},
+      {"offset", "M[,M...]", "half edge of the grids of each depth below 0, metres (default: the checkpoint's, else 0.15); must agree with the checkpoint's", ""},
       {"epsilon", "E", "probability, per depth, of a random voxel instead of the chosen one", "0"},
       {"index-noise", "SIGMA", "standard deviation of Gaussian noise on the last depth's voxel index, voxels", "0"},
       {"rotation-noise", "BINS", "standard deviation of Gaussian noise on the rotation bins (5 degrees each)", "0"},
@@ -122,8 +125,6 @@ static void run(const cli::Arguments& args) {
   exploration.index_noise = non_negative(args, "index-noise");
   exploration.rotation_noise = non_negative(args, "rotation-noise");
   exploration.gripper_flip = probability(args, "gripper-flip");
-  const double offset = args.real("offset");
-  if (!(offset > 0)) throw UsageError("--offset must be positive");
   const bool ignore_collisions = args.flag("ignore-collisions"), reload = args.flag("reload");
   const std::string png_dir = args.text("png");
 
@@ -136,14 +137,31 @@ static void run(const cli::Arguments& args) {
   };
   agree("voxels", networks.config().net.voxels);
   agree("depths", networks.config().depths);
-  voxels::CoarseToFine hierarchy;
-  try {
-    hierarchy.scene = voxels::GridBounds::parse(args.text("bounds"), networks.config().net.voxels);
-  } catch (const Error& e) {
-    throw UsageError(std::string("--bounds: ") + e.what());
-  }
+  // The hierarchy the networks were trained on; options that differ from it are refused.
+  voxels::CoarseToFine hierarchy = networks.hierarchy().value_or(voxels::CoarseToFine{});
   hierarchy.depths = networks.config().depths;
-  hierarchy.offset_m = offset;
+  hierarchy.scene.voxels = networks.config().net.voxels;
+  try {
+    if (args.has("bounds")) {
+      const voxels::GridBounds given = voxels::GridBounds::parse(args.text("bounds"), hierarchy.voxels());
+      if (networks.hierarchy() && voxels::bounds_values(given) != voxels::bounds_values(hierarchy.scene))
+        throw UsageError("--bounds " + args.text("bounds") + " differs from the bounds the checkpoint was trained on (" +
+                         checkpoint + ")");
+      hierarchy.scene = given;
+    }
+    if (args.has("offset")) {
+      const std::vector<double> given = voxels::CoarseToFine::parse_offsets(args.text("offset"), hierarchy.depths);
+      if (networks.hierarchy() && given != hierarchy.offsets_m)
+        throw UsageError("--offset " + args.text("offset") + " differs from the offsets the checkpoint was trained on (" +
+                         checkpoint + ")");
+      hierarchy.offsets_m = given;
+    }
+    hierarchy.validate();
+  } catch (const UsageError&) {
+    throw;
+  } catch (const Error& e) {
+    throw UsageError(e.what());
+  }
   if (!png_dir.empty() && ::mkdir(png_dir.c_str(), 0755) != 0 && errno != EEXIST)
     throw_system_error("cannot create directory " + png_dir);
 

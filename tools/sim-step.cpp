@@ -38,6 +38,8 @@ static cli::Usage usage() {
       {"task", "T", "run episodes of task T by itself (see --episodes)", ""},
       {"episodes", "N", "episodes to run with --task", "1"},
       {"variation", "V", "task variation with --task, or 'random' for one per episode", "0"},
+      {"scenes", "SET", "with --task, the scene set episodes are drawn from: demo, explore, eval (disjoint for every "
+                        "--seed) or any", "any"},
       {"cameras", "LIST", "comma-separated cameras: front, wrist, overhead", "front"},
       {"image-size", "WxH", "camera resolution, e.g. 128x128 or 256x256", "128x128"},
       {"every-step", "", "also write an observation at every 50 ms control step of a trajectory "
@@ -75,6 +77,7 @@ static void run(const cli::Arguments& args) {
   if (args.has("task")) {
     plan = simulator::EpisodePlan{args.text("task"), 0, static_cast<int>(args.integer("episodes")), args.seed()};
     plan->variation = args.text("variation") == "random" ? -1 : static_cast<int>(args.integer("variation"));
+    plan->scenes = simulator::scene_set_from_name(args.text("scenes"));
     tasks::make_task(plan->task);  // an unknown task fails before anything is written
   }
   const std::string input = args.positional().empty() ? "-" : args.positional()[0];

@@ -220,8 +220,7 @@ void EpisodeConverter::convert(std::vector<stream::Record>& episode, const strea
     }
   };
   const voxels::CoarseToFine& h = options_.hierarchy;
-  std::uniform_real_distribution<double> shift(-options_.crop_shift_fraction * h.offset_m,
-                                               options_.crop_shift_fraction * h.offset_m);
+  std::uniform_real_distribution<double> shift(-options_.crop_shift_fraction, options_.crop_shift_fraction);
   for (int start : starts) {
     int previous = start, step = 0;
     for (int k : keyframes) {
@@ -230,7 +229,8 @@ void EpisodeConverter::convert(std::vector<stream::Record>& episode, const strea
       const Eigen::Isometry3d pose = gripper_pose(target);
       std::vector<Eigen::Vector3d> shifts(h.depths, Eigen::Vector3d::Zero());
       if (options_.crop_augmentation)
-        for (int d = 1; d < h.depths; ++d) shifts[d] = Eigen::Vector3d(shift(rng_), shift(rng_), shift(rng_));
+        for (int d = 1; d < h.depths; ++d)  // a fraction of depth d's own half edge
+          shifts[d] = Eigen::Vector3d(shift(rng_), shift(rng_), shift(rng_)) * h.offset_at(d);
       const auto indices = h.indices_of(pose.translation(), shifts);
 
       stream::Record t("transition");

@@ -9,6 +9,7 @@
 #include "common/error.hpp"
 #include "qattention/proprio.hpp"
 #include "stream/reader.hpp"
+#include "voxels/grid_fields.hpp"
 #include "voxels/voxel_image.hpp"
 
 namespace qte::qattention {
@@ -30,7 +31,7 @@ constexpr int kOccupancyChannel = voxels::kChannels - 1;  // 1 when the voxel ho
 // worth (its voxel's Q + the value below) / 2.
 float path_value(const std::vector<float>& q_values) {
   float value = q_values.back();
-  for (int d = static_cast<int>(q_values.size()) - 2; d >= 0; --d) value = (q_values[d] + value) / 2;
+  for (int d = static_cast<int>(q_values.size()) - 2; d >= 0; --d) value = branch_value(q_values[d], value);
   return value;
 }
 
@@ -57,6 +58,7 @@ CheckpointNetworks::CheckpointNetworks(const std::string& path) : path_(path) {
   if (config_.net.proprio != kProprio)
     throw Error(path_ + ": the networks take " + std::to_string(config_.net.proprio) +
                 " proprioception inputs; qte-select gives " + std::to_string(kProprio));
+  hierarchy_ = voxels::hierarchy_of(record);
   nets_ = nets::make_coarse_to_fine_nets(config_.net, config_.depths);
   step_ = nets::load_checkpoint_record(record, nets_, nullptr);
 }

@@ -34,6 +34,9 @@ class CheckpointNetworks {
   const nets::CheckpointConfig& config() const { return config_; }
   const std::vector<nets::QAttentionNet>& nets() const { return nets_; }
   int64_t step() const { return step_; }  // the training step of the weights loaded
+  // The scene bounds and offsets the networks were trained on (a learner's checkpoint keeps
+  // them); nothing for a checkpoint of networks only.
+  const std::optional<voxels::CoarseToFine>& hierarchy() const { return hierarchy_; }
 
  private:
   // What identifies one version of a file on disk: a replacement renamed into place has
@@ -50,6 +53,7 @@ class CheckpointNetworks {
   std::string path_;
   FileVersion version_;
   nets::CheckpointConfig config_;
+  std::optional<voxels::CoarseToFine> hierarchy_;
   std::vector<nets::QAttentionNet> nets_;
   int64_t step_ = 0;
 };

@@ -24,8 +24,7 @@ Explored explore(const Choice& chosen, const Exploration& exploration, std::mt19
       if (d + 1 == depths) break;
       // The depths below, chosen again by tree expansion around the random voxel: a
       // hierarchy whose scene is the next depth's grid, evaluated by the deeper networks.
-      const voxels::CoarseToFine below{hierarchy.bounds_at(d + 1, c.bounds[d].centre_of(c.indices[d])),
-                                       depths - d - 1, hierarchy.offset_m};
+      const voxels::CoarseToFine below = hierarchy.below(d, c.bounds[d].centre_of(c.indices[d]));
       const DepthEvaluator deeper_nets = [&evaluate, d](int j, const float* grids, const float* p, int batch) {
         return evaluate(j + d + 1, grids, p, batch);
       };

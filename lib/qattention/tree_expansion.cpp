@@ -1,6 +1,7 @@
 #include "qattention/tree_expansion.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 #include "common/error.hpp"
@@ -30,8 +31,22 @@ Choice expand(const DepthEvaluator& evaluate, const voxels::CoarseToFine& hierar
   return expand_batch(evaluate, hierarchy, {cloud}, {proprio}, k).front();
 }
 
+void check_finite(const nets::QValues& q, int depth) {
+  for (const std::vector<float>* values : {&q.translation, &q.rotation, &q.gripper})
+    for (float x : *values)
+      if (!std::isfinite(x))
+        throw Error("the depth-" + std::to_string(depth) + " network gave a non-finite Q value (" + std::to_string(x) +
+                    "): a diverged checkpoint, or a non-finite input");
+}
+
 std::vector<Choice> expand_batch(const DepthEvaluator& evaluate, const voxels::CoarseToFine& hierarchy,
                                  const std::vector<voxels::PointCloud>& clouds,
+                                 const std::vector<std::vector<float>>& proprios, int k) {
+  return expand_batch(evaluate, nullptr, hierarchy, clouds, proprios, k);
+}
+
+std::vector<Choice> expand_batch(const DepthEvaluator& rank, const DepthEvaluator& value_of,
+                                 const voxels::CoarseToFine& hierarchy, const std::vector<voxels::PointCloud>& clouds,
                                  const std::vector<std::vector<float>>& proprios, int k) {
   if (k < 1) throw Error("tree expansion needs k >= 1");
   if (clouds.size() != proprios.size() || clouds.empty())
@@ -49,7 +64,9 @@ std::vector<Choice> expand_batch(const DepthEvaluator& evaluate, const voxels::C
     int parent_voxel = -1;
   };
   std::vector<std::vector<Node>> levels(depths);
-  std::vector<nets::QValues> outputs(depths);
+  // Per depth, the ranking networks' outputs and the valuing networks' (the same when one set
+  // of networks both ranks and values).
+  std::vector<nets::QValues> ranked(depths), valued(depths);
   for (std::size_t i = 0; i < clouds.size(); ++i) levels[0].push_back({hierarchy.scene, static_cast<int>(i), -1, -1});
   int expanded_grids = 0;
   for (int d = 0; d < depths; ++d) {
@@ -66,25 +83,32 @@ std::vector<Choice> expand_batch(const DepthEvaluator& evaluate, const voxels::C
     }
     for (const Node& node : level)
       proprio_batch.insert(proprio_batch.end(), proprios[node.observation].begin(), proprios[node.observation].end());
-    outputs[d] = evaluate(d, batch.data(), proprio_batch.data(), n);
-    if (static_cast<int>(outputs[d].translation.size()) != n * cells)
-      throw Error("tree expansion: depth " + std::to_string(d) + " returned the wrong number of Q values");
+    ranked[d] = rank(d, batch.data(), proprio_batch.data(), n);
+    if (value_of) valued[d] = value_of(d, batch.data(), proprio_batch.data(), n);
+    for (const nets::QValues* q : {&ranked[d], value_of ? &valued[d] : nullptr}) {
+      if (!q) continue;
+      if (static_cast<int>(q->translation.size()) != n * cells)
+        throw Error("tree expansion: depth " + std::to_string(d) + " returned the wrong number of Q values");
+      check_finite(*q, d);
+    }
     expanded_grids += n;
     if (d + 1 == depths) break;
     for (int i = 0; i < n; ++i)
-      for (int flat : top_k(outputs[d].translation.data() + static_cast<std::size_t>(i) * cells, cells, k))
+      for (int flat : top_k(ranked[d].translation.data() + static_cast<std::size_t>(i) * cells, cells, k))
         levels[d + 1].push_back({hierarchy.bounds_at(d + 1, level[i].bounds.centre_of(unflatten(flat, v))),
                                  level[i].observation, i, flat});
   }
 
-  // Values bottom-up: a leaf is worth its max Q; a node's value through child c is
-  // (q of c's voxel + c's value) / 2, and the node is worth its best child.
+  const std::vector<nets::QValues>& outputs = value_of ? valued : ranked;
+  // Values bottom-up: a leaf is worth the value of its best-ranked voxel (its max Q when one
+  // set of networks ranks and values); a node's value through child c is (q of c's voxel +
+  // c's value) / 2, and the node is worth its best child.
   std::vector<std::vector<float>> value(depths);
   std::vector<std::vector<int>> best_child(depths);
   const int leaf = depths - 1;
   for (std::size_t i = 0; i < levels[leaf].size(); ++i) {
-    const float* q = outputs[leaf].translation.data() + i * cells;
-    value[leaf].push_back(q[argmax(q, cells)]);
+    const float* q = ranked[leaf].translation.data() + i * cells;
+    value[leaf].push_back(outputs[leaf].translation[i * cells + argmax(q, cells)]);
   }
   for (int d = leaf - 1; d >= 0; --d) {
     value[d].assign(levels[d].size(), -1e30f);
@@ -92,7 +116,7 @@ std::vector<Choice> expand_batch(const DepthEvaluator& evaluate, const voxels::C
     for (std::size_t c = 0; c < levels[d + 1].size(); ++c) {
       const Node& child = levels[d + 1][c];
       const float q = outputs[d].translation[static_cast<std::size_t>(child.parent) * cells + child.parent_voxel];
-      const float through = (q + value[d + 1][c]) / 2;
+      const float through = branch_value(q, value[d + 1][c]);
       if (through > value[d][child.parent]) {  // strict: the earlier (higher-ranked) child wins ties
         value[d][child.parent] = through;
         best_child[d][child.parent] = static_cast<int>(c);
@@ -107,25 +131,25 @@ std::vector<Choice> expand_batch(const DepthEvaluator& evaluate, const voxels::C
     int node = static_cast<int>(root);
     choice.value = value[0][node];
     for (int d = 0; d < depths; ++d) {
-      const float* q = outputs[d].translation.data() + static_cast<std::size_t>(node) * cells;
-      const int voxel = d + 1 < depths ? levels[d + 1][best_child[d][node]].parent_voxel : argmax(q, cells);
+      const std::size_t at = static_cast<std::size_t>(node) * cells;
+      const int voxel = d + 1 < depths ? levels[d + 1][best_child[d][node]].parent_voxel
+                                       : argmax(ranked[d].translation.data() + at, cells);
       choice.indices.push_back(unflatten(voxel, v));
       choice.bounds.push_back(levels[d][node].bounds);
-      choice.q_values.push_back(q[voxel]);
+      choice.q_values.push_back(outputs[d].translation[at + voxel]);
       if (d + 1 < depths) node = best_child[d][node];
     }
-    const nets::QValues& last = outputs[leaf];
-    if (!last.rotation.empty()) {
-      const float* r =
-          last.rotation.data() + static_cast<std::size_t>(node) * nets::kRotationAxes * nets::kRotationBins;
+    if (!ranked[leaf].rotation.empty()) {
+      const std::size_t r = static_cast<std::size_t>(node) * nets::kRotationAxes * nets::kRotationBins;
       for (int axis = 0; axis < nets::kRotationAxes; ++axis) {
-        const float* axis_q = r + axis * nets::kRotationBins;
-        choice.rotation_bins[axis] = argmax(axis_q, nets::kRotationBins);
-        choice.rotation_q[axis] = axis_q[choice.rotation_bins[axis]];
+        const std::size_t at = r + axis * nets::kRotationBins;
+        choice.rotation_bins[axis] = argmax(ranked[leaf].rotation.data() + at, nets::kRotationBins);
+        choice.rotation_q[axis] = outputs[leaf].rotation[at + choice.rotation_bins[axis]];
       }
-      const float* g = last.gripper.data() + static_cast<std::size_t>(node) * nets::kGripperActions;
-      choice.gripper_open = g[1] > g[0];  // index 1 = open, as the transitions' gripper_open
-      choice.gripper_q = std::max(g[0], g[1]);
+      const std::size_t g = static_cast<std::size_t>(node) * nets::kGripperActions;
+      const int open = argmax(ranked[leaf].gripper.data() + g, nets::kGripperActions);
+      choice.gripper_open = open == 1;  // index 1 = open, as the transitions' gripper_open
+      choice.gripper_q = outputs[leaf].gripper[g + open];
     }
   }
   return choices;

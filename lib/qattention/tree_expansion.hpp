@@ -4,6 +4,11 @@
 // forward. A branch's value is (q_k + q'_k) / 2, q'_k being what the deeper level returns (at
 // the leaf, its volume's max Q); each level returns its best branch's value, and the agent
 // acts on the best path. K = 1 is exactly C2F-ARM's greedy coarse-to-fine choice.
+//
+// The learner's bootstrap target is the same tree with two sets of networks, as published
+// (double DQN over the tree): the online networks rank the top-K voxels of every non-leaf
+// grid and pick the leaf voxel and the heads' bins; the target networks value those indices,
+// and branch values and the max over branches are taken on the target networks' values.
 #pragma once
 
 #include <Eigen/Core>
@@ -23,7 +28,7 @@ using DepthEvaluator =
 struct Choice {
   std::vector<Eigen::Vector3i> indices;       // per depth
   std::vector<voxels::GridBounds> bounds;     // per depth
-  std::vector<float> q_values;                // the chosen voxel's Q, per depth
+  std::vector<float> q_values;                // the chosen voxel's Q, per depth (valuing networks)
   float value = 0;                            // the tree's value of the choice
   Eigen::Vector3i rotation_bins = Eigen::Vector3i::Zero();
   bool gripper_open = true;
@@ -32,6 +37,9 @@ struct Choice {
   int expanded_grids = 0;                     // grids evaluated (1 + K + K^2 + ...)
   Eigen::Vector3d position() const { return bounds.back().centre_of(indices.back()); }
 };
+
+// A branch's value: its voxel's Q and the value the deeper level returns, averaged (Algorithm 2).
+inline float branch_value(float q, float deeper_value) { return (q + deeper_value) / 2; }
 
 // The K best voxels of one Q volume (flat indices, best first, ties to the lower index).
 std::vector<int> top_k(const float* q, int count, int k);
@@ -47,6 +55,16 @@ Choice expand(const DepthEvaluator& evaluate, const voxels::CoarseToFine& hierar
 std::vector<Choice> expand_batch(const DepthEvaluator& evaluate, const voxels::CoarseToFine& hierarchy,
                                  const std::vector<voxels::PointCloud>& clouds,
                                  const std::vector<std::vector<float>>& proprios, int k);
+
+// The same with indices from `rank` (the online networks) and values from `value` (the target
+// networks), both evaluated on the grids `rank`'s choices lead to: the published target.
+std::vector<Choice> expand_batch(const DepthEvaluator& rank, const DepthEvaluator& value,
+                                 const voxels::CoarseToFine& hierarchy, const std::vector<voxels::PointCloud>& clouds,
+                                 const std::vector<std::vector<float>>& proprios, int k);
+
+// Throws Error when a network's output holds NaN or infinity (a diverged checkpoint, or a
+// non-finite input that reached the network): a max over NaN picks nothing.
+void check_finite(const nets::QValues& q, int depth);
 
 // The evaluator of a set of networks, one per depth.
 DepthEvaluator network_evaluator(const std::vector<nets::QAttentionNet>& nets);

@@ -22,6 +22,7 @@ bool ReplayBuffer::add(const stream::Record& record) {
   Stored stored{record,
                 {record.scalar<int64_t>("episode_key"), record.scalar<int32_t>("frame")},
                 {record.scalar<int64_t>("episode_key"), record.scalar<int32_t>("next_frame")},
+                record.has("step") ? record.scalar<int32_t>("step") : 0,
                 record.has("demo") && record.scalar<uint8_t>("demo") != 0};
   for (const FrameKey* key : {&stored.frame, &stored.next_frame})
     if (!frames_.count(*key))
@@ -46,14 +47,14 @@ bool ReplayBuffer::add(const stream::Record& record) {
     }
     slot = next_evicted_;
     next_evicted_ = (next_evicted_ + 1) % transitions_.size();
-    const auto acting = acting_on_.find(transitions_[slot].frame);
+    const auto acting = acting_on_.find({transitions_[slot].frame, transitions_[slot].step});
     if (acting != acting_on_.end() && acting->second == slot) acting_on_.erase(acting);
     release(transitions_[slot].frame);
     release(transitions_[slot].next_frame);
     demos_ -= transitions_[slot].demo;
   }
   demos_ += stored.demo;
-  acting_on_[stored.frame] = slot;
+  acting_on_[{stored.frame, stored.step}] = slot;
   if (slot == transitions_.size()) transitions_.push_back(std::move(stored));
   else transitions_[slot] = std::move(stored);
   tree_.set(slot, options_.prioritised ? tree_.max() : 1.0);  // new: sampled at least once soon
@@ -105,7 +106,7 @@ std::vector<double> ReplayBuffer::priorities() const {
   return p;
 }
 
-void ReplayBuffer::restore_priorities(const std::vector<double>& priorities) {
+void ReplayBuffer::restore_priorities(const std::vector<double>& priorities, double max_priority) {
   if (priorities.size() != transitions_.size())
     throw Error("replay: " + std::to_string(priorities.size()) + " priorities for " +
                 std::to_string(transitions_.size()) + " transitions");
@@ -113,6 +114,8 @@ void ReplayBuffer::restore_priorities(const std::vector<double>& priorities) {
     if (!(priorities[i] > 0) || !std::isfinite(priorities[i])) throw Error("replay: a priority is not positive");
     tree_.set(i, priorities[i]);
   }
+  if (!(max_priority > 0) || !std::isfinite(max_priority)) throw Error("replay: the largest priority is not positive");
+  tree_.restore_max(max_priority);
 }
 
 const stream::Record& ReplayBuffer::frame_of(std::size_t index) const {
@@ -124,7 +127,8 @@ const stream::Record& ReplayBuffer::next_frame_of(std::size_t index) const {
 }
 
 std::optional<std::size_t> ReplayBuffer::successor_of(std::size_t index) const {
-  const auto found = acting_on_.find(transitions_.at(index).next_frame);
+  const Stored& t = transitions_.at(index);
+  const auto found = acting_on_.find({t.next_frame, t.step + 1});
   if (found == acting_on_.end()) return std::nullopt;
   return found->second;
 }

@@ -45,21 +45,28 @@ class ReplayBuffer {
   double priority(std::size_t index) const { return tree_.get(index); }
   // Every transition's priority, in index order, and back (a learner's checkpoint).
   std::vector<double> priorities() const;
-  void restore_priorities(const std::vector<double>& priorities);
+  // The largest priority ever set, which new transitions start with: a resumed run must
+  // restore it as well for new transitions to be sampled as in an uninterrupted run.
+  double max_priority() const { return tree_.max(); }
+  void restore_priorities(const std::vector<double>& priorities, double max_priority);
 
   const stream::Record& transition(std::size_t index) const { return transitions_.at(index).record; }
   // The observation a transition acts on, and the one it reaches.
   const stream::Record& frame_of(std::size_t index) const;
   const stream::Record& next_frame_of(std::size_t index) const;
-  // The transition that continues `index`'s chain (acting on the observation it reaches), if
-  // the replay holds one: what n-step returns follow.
+  // The transition that continues `index`'s chain, if the replay holds one: what n-step
+  // returns follow. It acts on the observation `index` reaches, one step later; chains that
+  // share a frame at another step (demo augmentation starts chains at several frames) are
+  // others.
   std::optional<std::size_t> successor_of(std::size_t index) const;
 
  private:
   using FrameKey = std::pair<int64_t, int32_t>;  // (episode_key, frame)
+  using ChainKey = std::pair<FrameKey, int32_t>;  // (frame acted on, step of the chain)
   struct Stored {
     stream::Record record;
     FrameKey frame, next_frame;
+    int32_t step = 0;
     bool demo = false;
   };
   void release(const FrameKey& key);
@@ -67,7 +74,7 @@ class ReplayBuffer {
   ReplayOptions options_;
   std::vector<Stored> transitions_;
   std::map<FrameKey, std::pair<stream::Record, int>> frames_;  // frame and its reference count
-  std::map<FrameKey, std::size_t> acting_on_;  // the newest transition acting on each frame
+  std::map<ChainKey, std::size_t> acting_on_;  // the newest transition acting on each frame at each step
   SumTree tree_;
   std::size_t demos_ = 0;
   std::size_t next_evicted_ = 0;  // ring position among the agent's transitions

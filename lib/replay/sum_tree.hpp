@@ -17,6 +17,7 @@ class SumTree {
   double get(std::size_t index) const { return nodes_[leaf_offset_ + index]; }
   double total() const { return nodes_.empty() ? 0.0 : nodes_[1]; }
   double max() const { return max_; }  // largest priority ever set (new items start with it)
+  void restore_max(double max) { max_ = max; }  // a resumed run's
   // The index whose cumulative range holds `mass` (0 <= mass < total()).
   std::size_t find(double mass) const;
 

@@ -217,10 +217,32 @@ void Simulator::execute(const stream::Record& record,
   emit(observe(failure));
 }
 
+SceneSet scene_set_from_name(const std::string& name) {
+  for (SceneSet set : {SceneSet::any, SceneSet::demo, SceneSet::explore, SceneSet::eval})
+    if (name == scene_set_name(set)) return set;
+  throw UsageError("scenes '" + name + "': expected any, demo, explore or eval");
+}
+
+const char* scene_set_name(SceneSet set) {
+  switch (set) {
+    case SceneSet::demo: return "demo";
+    case SceneSet::explore: return "explore";
+    case SceneSet::eval: return "eval";
+    default: return "any";
+  }
+}
+
+uint64_t scene_seed(uint64_t run_seed, SceneSet set, uint64_t episode) {
+  if (set == SceneSet::any) return derive_seed(run_seed, episode);
+  const uint64_t stream = derive_seed(run_seed, 0x5ce5e700ull + static_cast<uint64_t>(set));
+  return (derive_seed(stream, episode) & ~uint64_t{3}) | static_cast<uint64_t>(set);  // < 2^63: derive_seed's range
+}
+
 stream::Record plan_reset(const EpisodePlan& plan, int index) {
-  const uint64_t seed = derive_seed(plan.seed, static_cast<uint64_t>(index));
+  const uint64_t seed = scene_seed(plan.seed, plan.scenes, static_cast<uint64_t>(index));
   int variation = plan.variation;
-  if (variation < 0) variation = static_cast<int>(seed % tasks::make_task(plan.task)->variation_count());
+  if (variation < 0)  // not from the low bits: they name the scene set
+    variation = static_cast<int>(derive_seed(seed, 0x7a) % tasks::make_task(plan.task)->variation_count());
   stream::Record reset("reset");
   reset.set_string("task", plan.task);
   reset.set_scalar<int32_t>("variation", variation);

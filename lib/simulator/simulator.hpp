@@ -79,15 +79,28 @@ class Simulator {
   robot::JointVector velocity_ = robot::JointVector::Zero();
 };
 
+// The scenes an episode may be drawn from. Demonstrations, exploration and evaluation use
+// disjoint sets by construction, whatever the run seeds: a scene seed's residue mod 4 names
+// its set. So no run can explore or be evaluated on a demonstrated scene. `any`: seeds
+// derived from the run seed alone, in no set (what a single sim-step run needs).
+enum class SceneSet { any = 0, demo = 1, explore = 2, eval = 3 };
+SceneSet scene_set_from_name(const std::string& name);  // any, demo, explore, eval; throws UsageError
+const char* scene_set_name(SceneSet set);
+// The scene seed of episode `episode` of a run seeded `run_seed`, in `set`.
+uint64_t scene_seed(uint64_t run_seed, SceneSet set, uint64_t episode);
+inline SceneSet scene_set_of(uint64_t scene_seed) { return static_cast<SceneSet>(scene_seed % 4); }
+
 // What sim-step runs by itself: episodes of one task, each reset from its own seed.
 struct EpisodePlan {
   std::string task;
   int variation = 0;  // -1: drawn per episode from its seed
   int episodes = 1;
   uint64_t seed = 0;
+  SceneSet scenes = SceneSet::any;
 };
 
-// The reset record of episode `index` of a plan (seed derived from plan.seed and index).
+// The reset record of episode `index` of a plan (its scene seed from plan.seed, plan.scenes
+// and index).
 stream::Record plan_reset(const EpisodePlan& plan, int index);
 
 // The sim-step filter: with a plan, starts its first episode at once and the next one after

@@ -8,6 +8,24 @@
 #include "common/error.hpp"
 
 namespace qte::voxels {
+namespace {
+
+// "A,B,C" as numbers; throws Error naming `what` and the item that is not one.
+std::vector<double> parse_numbers(const std::string& text, const char* what) {
+  std::vector<double> values;
+  std::size_t at = 0;
+  while (at <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', at), text.size());
+    const std::string item = text.substr(at, comma - at);
+    char* end = nullptr;
+    values.push_back(std::strtod(item.c_str(), &end));
+    if (item.empty() || *end != '\0') throw Error(std::string(what) + " '" + text + "': '" + item + "' is not a number");
+    at = comma + 1;
+  }
+  return values;
+}
+
+}  // namespace
 
 Eigen::Vector3i GridBounds::index_of(const Eigen::Vector3d& point) const {
   const Eigen::Vector3d scaled = (point - min_corner) / voxel_size_m();
@@ -32,16 +50,7 @@ GridBounds GridBounds::around(const Eigen::Vector3d& centre, double half_extent_
 }
 
 GridBounds GridBounds::parse(const std::string& text, int voxels) {
-  std::vector<double> v;
-  std::size_t at = 0;
-  while (at <= text.size()) {
-    const std::size_t comma = std::min(text.find(',', at), text.size());
-    const std::string item = text.substr(at, comma - at);
-    char* end = nullptr;
-    v.push_back(std::strtod(item.c_str(), &end));
-    if (item.empty() || *end != '\0') throw Error("bounds '" + text + "': '" + item + "' is not a number");
-    at = comma + 1;
-  }
+  const std::vector<double> v = parse_numbers(text, "bounds");
   if (v.size() != 4 || !(v[3] > 0) || !std::isfinite(v[0] + v[1] + v[2] + v[3]))
     throw Error("bounds '" + text + "': expected X,Y,Z,S (minimum corner and a positive edge length, metres)");
   if (voxels < 2) throw Error("a grid needs at least 2 voxels per side");
@@ -52,9 +61,34 @@ GridBounds GridBounds::parse(const std::string& text, int voxels) {
   return b;
 }
 
+void CoarseToFine::validate() const {
+  if (static_cast<int>(offsets_m.size()) != std::max(depths - 1, 0) && !(depths == 1 && offsets_m.size() == 1))
+    throw Error("the hierarchy has " + std::to_string(depths) + " depths and " + std::to_string(offsets_m.size()) +
+                " offsets: give one per depth below 0 (--offset 0.15,0.05 for 3 depths)");
+  for (double o : offsets_m)
+    if (!(o > 0) || !std::isfinite(o)) throw Error("offsets must be positive (metres)");
+}
+
 GridBounds CoarseToFine::bounds_at(int depth, const Eigen::Vector3d& previous_centre) const {
   if (depth == 0) return scene;
-  return GridBounds::around(previous_centre, offset_m, scene.voxels);
+  return GridBounds::around(previous_centre, offset_at(depth), scene.voxels);
+}
+
+CoarseToFine CoarseToFine::below(int depth, const Eigen::Vector3d& centre) const {
+  CoarseToFine h;
+  h.scene = bounds_at(depth + 1, centre);
+  h.depths = depths - depth - 1;
+  h.offsets_m.assign(offsets_m.begin() + std::min<std::size_t>(depth + 1, offsets_m.size()), offsets_m.end());
+  return h;
+}
+
+std::vector<double> CoarseToFine::parse_offsets(const std::string& text, int depths) {
+  const std::vector<double> offsets = parse_numbers(text, "offset");
+  CoarseToFine check;
+  check.depths = depths;
+  check.offsets_m = offsets;
+  check.validate();
+  return offsets;
 }
 
 std::vector<Eigen::Vector3i> CoarseToFine::indices_of(const Eigen::Vector3d& target,

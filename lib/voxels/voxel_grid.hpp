@@ -1,5 +1,5 @@
 // Coarse-to-fine voxel grids (C2F-ARM): depth 0 covers the scene bounds; depth d > 0 covers
-// centre +- offset around the voxel chosen at depth d-1. Index <-> coordinate conversions
+// centre +- offset[d-1] around the voxel chosen at depth d-1. Index <-> coordinate conversions
 // live here and only here: a voxel's coordinate is always its centre.
 #pragma once
 
@@ -30,15 +30,23 @@ struct GridBounds {
   static GridBounds parse(const std::string& text, int voxels);
 };
 
-// The hierarchy: scene bounds at depth 0, `depths` levels of `voxels`^3, offset 0.15 m.
+// The hierarchy: scene bounds at depth 0, `depths` levels of `voxels`^3, and one offset (half
+// edge) per depth below 0: published 0.15 m for the 2-depth C2F-ARM.
 struct CoarseToFine {
   GridBounds scene;
   int depths = 2;
-  double offset_m = 0.15;
+  std::vector<double> offsets_m = {0.15};  // offsets_m[d - 1] is depth d's half edge
 
   int voxels() const { return scene.voxels; }
+  double offset_at(int depth) const { return offsets_m.at(depth - 1); }
+  // Throws Error unless there is one positive offset per depth below 0.
+  void validate() const;
   // Bounds at `depth` given the centre chosen at depth-1 (ignored at depth 0).
   GridBounds bounds_at(int depth, const Eigen::Vector3d& previous_centre) const;
+  // The hierarchy below `depth`: depth+1's grid around `centre` as its scene, the deeper offsets.
+  CoarseToFine below(int depth, const Eigen::Vector3d& centre) const;
+  // "0.15" or "0.15,0.05" (the tools' --offset), checked against `depths`.
+  static std::vector<double> parse_offsets(const std::string& text, int depths);
   // The voxel index at every depth leading to `target` (each depth centred on the previous
   // depth's voxel centre, optionally shifted by `centre_shifts[d]` for crop augmentation).
   std::vector<Eigen::Vector3i> indices_of(const Eigen::Vector3d& target,

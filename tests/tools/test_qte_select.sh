@@ -175,6 +175,14 @@ err=$(qte-select --checkpoint "$ckpt" --voxels 32 < "$tmp/in.rec" 2>&1 >/dev/nul
 [ $rc = 2 ] && grep -q -- "--voxels 32 differs from the checkpoint's 16" <<<"$err" || fail "--voxels 32: exit $rc: $err"
 err=$(qte-select --checkpoint "$ckpt" --depths 3 < "$tmp/in.rec" 2>&1 >/dev/null); rc=$?
 [ $rc = 2 ] && grep -q -- "--depths 3 differs from the checkpoint's 2" <<<"$err" || fail "--depths 3: exit $rc: $err"
+err=$(qte-select --checkpoint "$ckpt" --bounds=-0.3,-0.5,0.7,1.0 < "$tmp/in.rec" 2>&1 >/dev/null); rc=$?
+[ $rc = 2 ] && grep -q -- "--bounds -0.3,-0.5,0.7,1.0 differs from the bounds the checkpoint was trained on" <<<"$err" \
+  || fail "other --bounds: exit $rc: $err"
+err=$(qte-select --checkpoint "$ckpt" --offset 0.1 < "$tmp/in.rec" 2>&1 >/dev/null); rc=$?
+[ $rc = 2 ] && grep -q -- "--offset 0.1 differs from the offsets the checkpoint was trained on" <<<"$err" \
+  || fail "other --offset: exit $rc: $err"
+qte-select --checkpoint "$ckpt" --bounds=-0.3,-0.5,0.6,1.0 --offset 0.15 --seed 5 "$tmp/in.rec" | cmp -s - "$tmp/greedy.rec" \
+  || fail "the checkpoint's own --bounds and --offset changed the actions"
 err=$(qte-select < "$tmp/in.rec" 2>&1 >/dev/null); rc=$?
 [ $rc = 2 ] && grep -q -- "--checkpoint FILE is required" <<<"$err" || fail "no --checkpoint: exit $rc: $err"
 err=$(stream-pack obs step:i32=0 terminal:u8=0 | qte-select --checkpoint "$ckpt" 2>&1 >/dev/null); rc=$?

@@ -93,7 +93,7 @@ TEST(RotationBins, RoundTripWithinHalfABin) {
 TEST(CropAugmentation, TheTargetStaysInsideTheDeeperGrid) {
   voxels::CoarseToFine h;
   std::mt19937 rng(8);
-  std::uniform_real_distribution<double> u(0, 1), shift(-0.75 * h.offset_m, 0.75 * h.offset_m);
+  std::uniform_real_distribution<double> u(0, 1), shift(-0.75 * h.offset_at(1), 0.75 * h.offset_at(1));
   for (int i = 0; i < 5000; ++i) {
     const Eigen::Vector3d target = h.scene.min_corner + Eigen::Vector3d(u(rng), u(rng), u(rng)) * h.scene.size_m;
     const std::vector<Eigen::Vector3d> shifts = {Eigen::Vector3d::Zero(), Eigen::Vector3d(shift(rng), shift(rng), shift(rng))};

@@ -7,77 +7,14 @@
 
 #include "common/error.hpp"
 #include "learner/q_learner.hpp"
+#include "learner_fixtures.hpp"
 #include "nets/qattention_modules.hpp"
 
 using namespace qte;
 
 namespace {
 
-constexpr int V = 16;
-
-// A frame with a synthetic point cloud: a floor of grey points and one coloured block whose
-// position identifies the frame (what the networks can tell frames apart by).
-stream::Record frame(int64_t episode, int32_t index, const Eigen::Vector3f& block, uint8_t red) {
-  std::mt19937 rng(static_cast<uint32_t>(episode * 100 + index));
-  std::uniform_real_distribution<float> u(0, 1);
-  std::vector<float> xyz;
-  std::vector<uint8_t> rgb;
-  for (int i = 0; i < 1500; ++i) {
-    xyz.insert(xyz.end(), {-0.3f + u(rng), -0.5f + u(rng), 0.76f});
-    rgb.insert(rgb.end(), {90, 90, 90});
-  }
-  for (int i = 0; i < 300; ++i) {
-    xyz.insert(xyz.end(), {block.x() + 0.04f * u(rng), block.y() + 0.04f * u(rng), block.z() + 0.04f * u(rng)});
-    rgb.insert(rgb.end(), {red, 20, 20});
-  }
-  stream::Record r("frame");
-  r.set_scalar<int64_t>("episode_key", episode);
-  r.set_scalar<int32_t>("frame", index);
-  const int64_t n = static_cast<int64_t>(rgb.size() / 3);
-  r.set<float>("front.points", {1, n, 3}, xyz);
-  r.set<uint8_t>("front.rgb", {1, n, 3}, rgb);
-  r.set_scalar<uint8_t>("gripper_open", 1);
-  r.set_scalar<double>("gripper_opening_m", 0.08);
-  return r;
-}
-
-// A transition to the block's voxel at every depth, terminal with reward 100 (target 1).
-stream::Record transition(const voxels::CoarseToFine& h, int64_t episode, const Eigen::Vector3d& goal, bool terminal) {
-  stream::Record t("transition");
-  t.set_scalar<int64_t>("episode_key", episode);
-  t.set_scalar<int32_t>("frame", 0);
-  t.set_scalar<int32_t>("next_frame", 1);
-  t.set_scalar<int32_t>("step", 0);
-  t.set_scalar<int32_t>("voxels", V);
-  const auto indices = h.indices_of(goal);
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  for (int d = 0; d < h.depths; ++d) {
-    const voxels::GridBounds b = h.bounds_at(d, centre);
-    t.set<int32_t>("depth" + std::to_string(d) + ".index", {3}, indices[d].data());
-    t.set<double>("depth" + std::to_string(d) + ".bounds", {4},
-                  std::vector<double>{b.min_corner.x(), b.min_corner.y(), b.min_corner.z(), b.size_m});
-    centre = b.centre_of(indices[d]);
-  }
-  t.set<int32_t>("rotation_bins", {3}, std::vector<int32_t>{36, 36, 18});
-  t.set_scalar<uint8_t>("gripper_open", 0);
-  t.set_scalar<uint8_t>("ignore_collisions", 0);
-  t.set_scalar<float>("reward", terminal ? 100.0f : 0.0f);
-  t.set_scalar<uint8_t>("terminal", terminal);
-  t.set_scalar<uint8_t>("demo", 1);
-  return t;
-}
-
-// Four episodes, each one terminal transition to its block.
-replay::ReplayBuffer tiny_replay(const learner::LearnerConfig& config) {
-  replay::ReplayBuffer replay;
-  const Eigen::Vector3f blocks[4] = {{0.1f, -0.2f, 0.78f}, {0.3f, 0.2f, 0.78f}, {0.0f, 0.3f, 0.78f}, {0.4f, -0.3f, 0.78f}};
-  for (int e = 0; e < 4; ++e) {
-    replay.add(frame(e, 0, blocks[e], 220));
-    replay.add(frame(e, 1, blocks[e], 220));
-    replay.add(transition(config.hierarchy, e, blocks[e].cast<double>() + Eigen::Vector3d(0.02, 0.02, 0.02), true));
-  }
-  return replay;
-}
+using namespace qte::test_support;
 
 learner::LearnerConfig small_config() {
   learner::LearnerConfig config;
@@ -226,6 +163,7 @@ TEST(QLearner, RefusesTransitionsOfAnotherGrid) {
   learner::LearnerConfig config = small_config();
   voxels::CoarseToFine three = config.hierarchy;
   three.depths = 3;
+  three.offsets_m = {0.15, 0.05};
   const stream::Record deeper = transition(three, 0, {0.1, 0.1, 0.8}, true);
   EXPECT_THROW(learner::check_transition(deeper, config), StreamError);
   stream::Record other = transition(config.hierarchy, 0, {0.1, 0.1, 0.8}, true);
@@ -277,4 +215,131 @@ TEST(QLearner, NStepReturnsFollowTheChain) {
   EXPECT_FLOAT_EQ(three.reward[0], 99.0f);
   EXPECT_FLOAT_EQ(three.discount[0], 0);
   EXPECT_FLOAT_EQ(three.next_proprio[0][3], 1.0f - 2.0f * 2 / 9);  // the observation after step 1
+}
+
+// Demo augmentation starts chains at several frames, so one frame is acted on at different
+// steps of different chains: the n-step return follows its own chain (the step after its
+// own), not the newest transition acting on the frame reached.
+TEST(QLearner, NStepReturnsStayInTheirChainWhereChainsShareAFrame) {
+  learner::LearnerConfig config = small_config();
+  replay::ReplayBuffer replay;
+  const Eigen::Vector3f block(0.1f, -0.2f, 0.78f);
+  for (int32_t f : {0, 5, 10, 20}) replay.add(frame(4, f, block, 220));
+  const auto link = [&](int32_t from, int32_t to, int32_t step, bool terminal) {
+    stream::Record t = transition(config.hierarchy, 4, {0.1, -0.2, 0.8}, terminal);
+    t.set_scalar<int32_t>("frame", from);
+    t.set_scalar<int32_t>("next_frame", to);
+    t.set_scalar<int32_t>("step", step);
+    t.set_scalar<float>("reward", terminal ? 100.0f : 0.0f);
+    replay.add(t);
+  };
+  link(0, 10, 0, false);   // 0: chain from frame 0: keyframes 10, 20
+  link(10, 20, 1, true);   // 1
+  link(5, 10, 0, false);   // 2: chain from frame 5, same keyframes, same steps
+  link(10, 20, 1, true);   // 3
+  link(0, 5, 0, false);    // 4: a chain through frame 5 first: frame 10 at step 2
+  link(5, 10, 1, false);   // 5
+  link(10, 20, 2, true);   // 6: the newest transition acting on frame 10
+  EXPECT_EQ(replay.successor_of(0), std::optional<std::size_t>(3));  // step 1 on frame 10 (1 and 3 are alike)
+  EXPECT_EQ(replay.successor_of(5), std::optional<std::size_t>(6));
+  EXPECT_EQ(replay.successor_of(4), std::optional<std::size_t>(5));
+  config.n_step = 2;
+  const learner::Minibatch b = learner::assemble_minibatch(replay, replay::Sample{{0, 4}, {1.0, 1.0}}, config);
+  EXPECT_FLOAT_EQ(b.reward[0], 99.0f);  // 0 + 0.99 * 100, terminal within 2
+  EXPECT_FLOAT_EQ(b.discount[0], 0);
+  EXPECT_FLOAT_EQ(b.reward[1], 0);  // 0 -> 5 -> 10: not terminal; bootstraps from frame 10 at step 2
+  EXPECT_FLOAT_EQ(b.discount[1], 0.99f * 0.99f);
+  EXPECT_FLOAT_EQ(b.next_proprio[1][3], 1.0f - 2.0f * 2 / 9);  // the time input of step 2
+}
+
+namespace {
+
+std::vector<float> gradient_values(const std::vector<nets::QAttentionNet>& nets, int depth) {
+  std::vector<float> all;
+  for (const auto& p : nets[depth].module().parameters()) {
+    if (!p.grad().defined()) continue;
+    const auto g = p.grad().contiguous();
+    all.insert(all.end(), g.data_ptr<float>(), g.data_ptr<float>() + g.numel());
+  }
+  return all;
+}
+
+double huber(double x) { return std::abs(x) < 1 ? 0.5 * x * x : std::abs(x) - 0.5; }
+
+}  // namespace
+
+// Published: every gradient element clipped to +-0.01, each depth's network on its own.
+TEST(QLearner, GradientsAreClippedByValuePerDepth) {
+  nets::set_torch_threads(2);
+  for (double clip : {0.0, 0.01}) {
+    SCOPED_TRACE("clip " + std::to_string(clip));
+    nets::seed_torch(17);
+    learner::LearnerConfig config = small_config();
+    config.grad_clip_value = clip;
+    learner::QLearner learner(config);
+    replay::ReplayBuffer replay = tiny_replay(config);
+    learner.gradients(learner::assemble_minibatch(replay, all_of(replay), config));
+    for (int d = 0; d < 2; ++d) {
+      const std::vector<float> g = gradient_values(learner.online(), d);
+      ASSERT_FALSE(g.empty());
+      float largest = 0;
+      int at_bound = 0;
+      for (float x : g) {
+        largest = std::max(largest, std::abs(x));
+        at_bound += std::abs(std::abs(x) - 0.01f) < 1e-9f;
+      }
+      if (clip > 0) {
+        EXPECT_LE(largest, 0.01f + 1e-9f) << "depth " << d;
+        EXPECT_GT(at_bound, 0) << "depth " << d << ": nothing was clipped, the case shows nothing";
+      } else {
+        EXPECT_GT(largest, 0.01f) << "depth " << d << ": unclipped gradients this small show nothing";
+      }
+    }
+  }
+}
+
+// The loss against one written out here from the networks' outputs: per sample the Huber TD
+// error (at the last depth the mean of translation, three rotation axes and gripper) plus
+// lambda * (mean |translation Q| + at the last depth mean |the head's 218 outputs|), weighted
+// by the importance weights, then the batch mean.
+TEST(QLearner, LossIsOneMeanOverFiveTermsAndRegularisedWithImportanceWeights) {
+  nets::set_torch_threads(2);
+  nets::seed_torch(19);
+  learner::LearnerConfig config = small_config();
+  config.q_regularisation = 0.7;
+  learner::QLearner learner(config);
+  replay::ReplayBuffer replay = tiny_replay(config);
+  learner::Minibatch batch = learner::assemble_minibatch(replay, all_of(replay), config);
+  batch.weights = {1.0, 0.5, 0.25, 0.75};
+  const learner::Targets targets = learner.targets(batch);
+  const learner::StepStats stats = learner.gradients(batch);
+  const int n = batch.size, cells = V * V * V;
+  double total = 0;
+  for (int d = 0; d < 2; ++d) {
+    const nets::QValues q = learner.online()[d].predict(batch.grids[d].data(), batch.proprio.data(), n);
+    double loss = 0;
+    for (int i = 0; i < n; ++i) {
+      const float* t = q.translation.data() + static_cast<std::size_t>(i) * cells;
+      double td = huber(t[batch.voxel[d][i]] - targets.translation[d][i]);
+      double reg = 0;
+      for (int c = 0; c < cells; ++c) reg += std::abs(t[c]) / cells;
+      if (d == 1) {
+        double head_reg = 0;
+        for (int axis = 0; axis < 3; ++axis) {
+          const float* r = q.rotation.data() + (static_cast<std::size_t>(i) * 3 + axis) * 72;
+          td += huber(r[batch.rotation_bins[3 * i + axis]] - targets.rotation[3 * i + axis]);
+          for (int b = 0; b < 72; ++b) head_reg += std::abs(r[b]) / 218;
+        }
+        const float* g = q.gripper.data() + static_cast<std::size_t>(i) * 2;
+        td += huber(g[batch.gripper[i]] - targets.gripper[i]);
+        head_reg += (std::abs(g[0]) + std::abs(g[1])) / 218;
+        td /= 5;
+        reg += head_reg;
+      }
+      loss += batch.weights[i] * (td + 0.7 * reg) / n;
+    }
+    EXPECT_NEAR(stats.depth_loss[d], loss, 1e-5 * std::abs(loss) + 1e-7) << "depth " << d;
+    total += loss;
+  }
+  EXPECT_NEAR(stats.loss, total, 1e-5 * std::abs(total));
 }

@@ -60,6 +60,7 @@ struct Scene {
   Choice chosen;
   explicit Scene(int depths) {
     q.depths = hierarchy.depths = depths;
+    hierarchy.offsets_m.assign(std::max(depths - 1, 1), 0.15);
     chosen = expand(std::ref(q), hierarchy, cloud.view(), proprio, k);
     q.calls = 0;
   }

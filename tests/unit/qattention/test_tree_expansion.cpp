@@ -220,6 +220,7 @@ void expect_same_as_algorithm2(const DepthEvaluator& evaluate, int depths, int k
   SCOPED_TRACE("depths " + std::to_string(depths) + ", K " + std::to_string(k));
   voxels::CoarseToFine hierarchy;
   hierarchy.depths = depths;
+  hierarchy.offsets_m.assign(std::max(depths - 1, 1), 0.15);
   const std::vector<float> proprio = {1, 0.04f, 0.04f, 0.5f};
   int batched_calls = 0, plain_calls = 0;
   const DepthEvaluator counted = [&](int depth, const float* grids, const float* p, int batch) {
@@ -320,6 +321,7 @@ TEST(TreeExpansion, FinerDepthResolvesCoarseAmbiguityBetweenTwoObjects) {
 TEST(TreeExpansion, ThreeDepthsNestAsAlgorithmTwoByHand) {
   voxels::CoarseToFine hierarchy;
   hierarchy.depths = 3;
+  hierarchy.offsets_m = {0.15, 0.15};  // depth 2 as wide as depth 1: the groups' geometry below
   const Eigen::Vector3d group_a = hierarchy.scene.centre_of({4, 8, 4});
   const Eigen::Vector3d group_b = hierarchy.scene.centre_of({11, 4, 4});
   const Eigen::Vector3d along_x(0.02, 0, 0), along_y(0, 0.02, 0);
@@ -356,7 +358,7 @@ TEST(TreeExpansion, ThreeDepthsNestAsAlgorithmTwoByHand) {
     voxels::GridBounds bounds = hierarchy.scene;
     for (const Eigen::Vector3d& p : {first, second, third}) {
       indices.push_back(bounds.index_of(p));
-      bounds = hierarchy.bounds_at(static_cast<int>(indices.size()), bounds.centre_of(indices.back()));
+      if (indices.size() < 3) bounds = hierarchy.bounds_at(static_cast<int>(indices.size()), bounds.centre_of(indices.back()));
     }
     return indices;
   };

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <fstream>
 
 #include "replay/growing_stream.hpp"
@@ -142,4 +143,44 @@ TEST(GrowingStream, ReturnsWholeRecordsAsTheyArrive) {
   EXPECT_THROW(growing.poll(), StreamError);
   ::close(fd);
   ::unlink(path);
+}
+
+// Published importance weights: 1 / sqrt(P(i)), normalised by the batch's largest. With
+// beta 0.5 the replay's (N P(i))^-beta over its maximum is that, written here independently.
+TEST(ReplayBuffer, ImportanceWeightsAreOneOverRootPNormalisedByTheBatchMaximum) {
+  ReplayBuffer replay;
+  add_episode(replay, 1, 6, true);
+  replay.update_priorities({0, 1, 2, 3, 4, 5}, {0.1, 0.5, 1.0, 2.0, 4.0, 8.0});
+  double total = 0;
+  for (double p : replay.priorities()) total += p;
+  std::mt19937_64 rng(5);
+  for (int round = 0; round < 50; ++round) {
+    const Sample s = replay.sample(4, 0.5, rng);
+    double largest = 0;
+    for (std::size_t index : s.indices) largest = std::max(largest, 1 / std::sqrt(replay.priority(index) / total));
+    for (std::size_t i = 0; i < s.indices.size(); ++i)
+      EXPECT_NEAR(s.weights[i], 1 / std::sqrt(replay.priority(s.indices[i]) / total) / largest, 1e-12);
+  }
+}
+
+// New transitions start at the largest priority ever set: a resumed replay restores it, so a
+// transition added after the resume is sampled as in the run that was never stopped.
+TEST(ReplayBuffer, RestoredPrioritiesKeepTheLargestEverForNewTransitions) {
+  ReplayBuffer straight;
+  add_episode(straight, 1, 3, false);
+  straight.update_priorities({0, 1, 2}, {9.0, 0.1, 0.2});  // the largest ever: 9's
+  straight.update_priorities({0}, {0.3});                 // ... no longer held by any transition
+  const std::vector<double> saved = straight.priorities();
+  const double saved_max = straight.max_priority();
+  ReplayBuffer resumed;
+  add_episode(resumed, 1, 3, false);
+  resumed.restore_priorities(saved, saved_max);
+  for (ReplayBuffer* r : {&straight, &resumed}) add_episode(*r, 2, 1, false);
+  EXPECT_DOUBLE_EQ(resumed.priority(3), straight.priority(3));
+  EXPECT_DOUBLE_EQ(resumed.priority(3), std::pow(9.001, 0.7));
+  ReplayBuffer forgetful;  // what a resume without it gave
+  add_episode(forgetful, 1, 3, false);
+  forgetful.restore_priorities(saved, 1.0);
+  add_episode(forgetful, 2, 1, false);
+  EXPECT_NE(forgetful.priority(3), straight.priority(3));
 }

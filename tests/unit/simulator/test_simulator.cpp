@@ -1,6 +1,9 @@
 // The sim-step loop: resets, trajectories, failures, determinism and the tasks' experts.
 #include <gtest/gtest.h>
 
+#include <set>
+
+#include "common/random.hpp"
 #include "trajectory_helpers.hpp"
 #include "stream/codec.hpp"
 #include "tasks/task.hpp"
@@ -220,3 +223,36 @@ TEST_P(ExpertSolves, SeveralSeeds) {
 
 INSTANTIATE_TEST_SUITE_P(Tasks, ExpertSolves,
                          ::testing::Values("reach_target", "pick_and_lift", "lift_numbered_block"));
+
+// Demonstration, exploration and evaluation scenes never meet, for any run seed: with the
+// seeds examples/learn.sh gives (demo-record --seed S, sim-step --seed S * 100000 + chunk
+// for exploration, --seed 1000000 for evaluation), and even when all three share one seed.
+TEST(SceneSets, DemoExplorationAndEvaluationSeedsAreDisjointForSeedsZeroToNine) {
+  std::set<uint64_t> eval;
+  for (uint64_t e = 0; e < 50; ++e) eval.insert(scene_seed(1000000, SceneSet::eval, e));
+  for (uint64_t run = 0; run < 10; ++run) {
+    std::set<uint64_t> demo, explore;
+    for (uint64_t e = 0; e < 100; ++e) demo.insert(scene_seed(run, SceneSet::demo, e));
+    for (uint64_t chunk = 0; chunk < 50; ++chunk)
+      for (uint64_t e = 0; e < 10; ++e) explore.insert(scene_seed(run * 100000 + chunk, SceneSet::explore, e));
+    for (uint64_t e = 0; e < 50; ++e) eval.insert(scene_seed(run, SceneSet::eval, e));  // the same run seed too
+    EXPECT_EQ(demo.size(), 100u);
+    EXPECT_EQ(explore.size(), 500u);
+    for (uint64_t s : demo) {
+      EXPECT_EQ(scene_set_of(s), SceneSet::demo);
+      EXPECT_FALSE(explore.count(s) || eval.count(s)) << "run " << run << ": demo scene " << s;
+    }
+    for (uint64_t s : explore) {
+      EXPECT_EQ(scene_set_of(s), SceneSet::explore);
+      EXPECT_FALSE(eval.count(s)) << "run " << run << ": exploration scene " << s;
+    }
+  }
+  for (uint64_t s : eval) EXPECT_EQ(scene_set_of(s), SceneSet::eval);
+  // The reset records carry them, and the seeds of old ('any') stay what they were.
+  EpisodePlan plan{"reach_target", 0, 3, 0};
+  plan.scenes = SceneSet::explore;
+  EXPECT_EQ(static_cast<uint64_t>(plan_reset(plan, 2).scalar<int64_t>("seed")), scene_seed(0, SceneSet::explore, 2));
+  EXPECT_EQ(scene_seed(5, SceneSet::any, 2), qte::derive_seed(5, 2));
+  EXPECT_EQ(scene_set_from_name("eval"), SceneSet::eval);
+  EXPECT_THROW(scene_set_from_name("test"), qte::UsageError);
+}

@@ -2,6 +2,7 @@
 
 #include <random>
 
+#include "common/error.hpp"
 #include "voxels/voxel_grid.hpp"
 
 using namespace qte::voxels;
@@ -9,6 +10,7 @@ using namespace qte::voxels;
 TEST(VoxelGrid, IndexAndCentreRoundTripAtEveryDepth) {
   CoarseToFine hierarchy;
   hierarchy.depths = 3;
+  hierarchy.offsets_m = {0.15, 0.05};
   std::mt19937 rng(2);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (int trial = 0; trial < 1000; ++trial) {
@@ -34,6 +36,28 @@ TEST(VoxelGrid, DepthOneCoversThirtyCentimetresInTwoCentimetreVoxels) {
   EXPECT_DOUBLE_EQ(deeper.size_m, 0.3);
   EXPECT_NEAR(deeper.voxel_size_m(), 0.01875, 1e-12);
   EXPECT_TRUE(deeper.centre_of({8, 8, 8}).isApprox(Eigen::Vector3d(0.1, 0.2, 0.9) + Eigen::Vector3d::Constant(0.01875 / 2)));
+}
+
+// One offset per depth below 0: with 0.15, 0.05 depth 1 is a 30 cm cube and depth 2 a 10 cm
+// one (not another 30 cm cube), and the sub-hierarchy below depth 0 carries depth 2's offset.
+TEST(VoxelGrid, EachDepthHasItsOwnOffset) {
+  CoarseToFine h;
+  h.depths = 3;
+  h.offsets_m = CoarseToFine::parse_offsets("0.15,0.05", 3);
+  const Eigen::Vector3d centre(0.1, 0.2, 0.9);
+  EXPECT_DOUBLE_EQ(h.bounds_at(1, centre).size_m, 0.3);
+  EXPECT_DOUBLE_EQ(h.bounds_at(2, centre).size_m, 0.1);
+  EXPECT_NEAR(h.bounds_at(2, centre).voxel_size_m(), 0.00625, 1e-12);
+  const CoarseToFine below = h.below(0, centre);
+  EXPECT_EQ(below.depths, 2);
+  EXPECT_DOUBLE_EQ(below.scene.size_m, 0.3);
+  EXPECT_DOUBLE_EQ(below.bounds_at(1, centre).size_m, 0.1);
+  EXPECT_NO_THROW(below.validate());
+  // One offset for three depths, a negative one, words: refused.
+  EXPECT_THROW(CoarseToFine::parse_offsets("0.15", 3), qte::Error);
+  EXPECT_THROW(CoarseToFine::parse_offsets("0.15,-0.05", 3), qte::Error);
+  EXPECT_THROW(CoarseToFine::parse_offsets("0.15,x", 3), qte::Error);
+  EXPECT_EQ(CoarseToFine::parse_offsets("0.15", 2), std::vector<double>{0.15});
 }
 
 namespace {

@@ -1,0 +1,92 @@
+#include "learner/minibatch.hpp"
+
+#include <cmath>
+
+#include "qattention/proprio.hpp"
+#include "voxels/grid_fields.hpp"
+
+namespace qte::learner {
+namespace {
+
+std::string depth_field(int depth, const char* what) { return "depth" + std::to_string(depth) + "." + what; }
+
+}  // namespace
+
+void check_transition(const stream::Record& t, const LearnerConfig& config) {
+  const int v = config.hierarchy.voxels(), depths = config.hierarchy.depths;
+  if (t.has("voxels") && t.scalar<int32_t>("voxels") != v)
+    t.fail("voxels", std::to_string(v) + " voxels per side, as the networks (--voxels); the transition has " +
+                         std::to_string(t.scalar<int32_t>("voxels")));
+  for (int d = 0; d < depths; ++d) {
+    if (!t.has(depth_field(d, "index")))
+      t.fail(depth_field(d, "index"), "an action at each of the networks' " + std::to_string(depths) + " depths (--depths)");
+    const auto index = t.array<int32_t>(depth_field(d, "index"));
+    if (index.size() != 3) t.fail(depth_field(d, "index"), "int32 [3]");
+    for (int axis = 0; axis < 3; ++axis)
+      if (index[axis] < 0 || index[axis] >= v)
+        t.fail(depth_field(d, "index"), "voxel indices in 0.." + std::to_string(v - 1) + " (--voxels " + std::to_string(v) + ")");
+    voxels::bounds_field(t, depth_field(d, "bounds"), v);
+  }
+  if (t.has(depth_field(depths, "index")))
+    t.fail(depth_field(depths, "index"), "no more than the networks' " + std::to_string(depths) + " depths (--depths)");
+  const auto bins = t.array<int32_t>("rotation_bins");
+  if (bins.size() != 3) t.fail("rotation_bins", "int32 [3]");
+  for (int axis = 0; axis < 3; ++axis)
+    if (bins[axis] < 0 || bins[axis] >= nets::kRotationBins) t.fail("rotation_bins", "bins in 0..71");
+  if (!std::isfinite(t.scalar<float>("reward"))) t.fail("reward", "a finite reward");
+}
+
+Minibatch assemble_minibatch(const replay::ReplayBuffer& replay, const replay::Sample& sample,
+                             const LearnerConfig& config) {
+  const voxels::CoarseToFine& h = config.hierarchy;
+  const int v = h.voxels(), depths = h.depths;
+  const std::size_t grid_floats = static_cast<std::size_t>(v) * v * v * voxels::kChannels;
+  Minibatch b;
+  b.size = static_cast<int>(sample.indices.size());
+  b.indices = sample.indices;
+  b.weights = sample.weights;
+  b.grids.assign(depths, std::vector<float>(grid_floats * b.size));
+  b.voxel.assign(depths, std::vector<int64_t>(b.size));
+  for (int i = 0; i < b.size; ++i) {
+    const std::size_t index = sample.indices[i];
+    const stream::Record& t = replay.transition(index);  // checked when read (check_transition)
+    const stream::Record& frame = replay.frame_of(index);
+    const voxels::ObservationCloud cloud = voxels::observation_cloud(frame);
+    for (int d = 0; d < depths; ++d) {
+      const voxels::GridBounds g = voxels::bounds_field(t, depth_field(d, "bounds"), v);
+      const auto index3 = t.array<int32_t>(depth_field(d, "index"));
+      b.voxel[d][i] = (static_cast<int64_t>(index3[0]) * v + index3[1]) * v + index3[2];
+      voxels::voxelize(cloud.view(), g, b.grids[d].data() + i * grid_floats);
+    }
+    const std::vector<float> p = qattention::proprio_of(frame, t.scalar<int32_t>("step"));
+    b.proprio.insert(b.proprio.end(), p.begin(), p.end());
+    const auto bins = t.array<int32_t>("rotation_bins");
+    for (int axis = 0; axis < 3; ++axis) b.rotation_bins.push_back(bins[axis]);
+    b.gripper.push_back(t.scalar<uint8_t>("gripper_open") != 0 ? 1 : 0);
+    // The n-step return: rewards along the chain until it ends or n transitions are summed,
+    // then the discounted value of the observation reached.
+    std::size_t last = index;
+    double reward = 0, discount = 1;
+    for (int n = 0; n < config.n_step; ++n) {
+      const stream::Record& u = replay.transition(last);
+      reward += discount * u.scalar<float>("reward");
+      discount *= config.gamma;
+      if (u.scalar<uint8_t>("terminal") != 0) {
+        discount = 0;
+        break;
+      }
+      if (n + 1 == config.n_step) break;
+      const std::optional<std::size_t> successor = replay.successor_of(last);
+      if (!successor) break;
+      last = *successor;
+    }
+    b.reward.push_back(static_cast<float>(reward));
+    b.discount.push_back(static_cast<float>(discount));
+    const stream::Record& next = replay.next_frame_of(last);
+    b.next_clouds.push_back(voxels::observation_cloud(next));
+    b.next_proprio.push_back(qattention::proprio_of(next, replay.transition(last).scalar<int32_t>("step") + 1));
+  }
+  return b;
+}
+
+}  // namespace qte::learner

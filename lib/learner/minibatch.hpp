@@ -1,0 +1,41 @@
+// Replayed transitions in the form the networks take: each sampled transition's grids along
+// its action's path, its proprioception, the action's indices, and what its bootstrap target
+// needs (the n-step reward, the discount, the observation reached).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "learner/settings.hpp"
+#include "replay/replay_buffer.hpp"
+#include "stream/record.hpp"
+#include "voxels/observation_cloud.hpp"
+
+namespace qte::learner {
+
+struct Minibatch {
+  int size = 0;
+  std::vector<std::vector<float>> grids;    // per depth: [B, V, V, V, C] over the action's bounds
+  std::vector<float> proprio;               // [B, P]
+  std::vector<std::vector<int64_t>> voxel;  // per depth: the action's voxel, flat (x, y, z order)
+  std::vector<int64_t> rotation_bins;       // [B, 3]
+  std::vector<int64_t> gripper;             // [B]: 1 = open (the gripper head's index)
+  std::vector<float> reward;                // as stored (100 on success); the discounted sum over n steps
+  std::vector<float> discount;              // gamma^n, or 0 when the chain ends within n steps
+  std::vector<voxels::ObservationCloud> next_clouds;
+  std::vector<std::vector<float>> next_proprio;
+  std::vector<double> weights;              // importance weights
+  std::vector<std::size_t> indices;         // replay indices
+};
+
+// Voxelizes the sampled transitions' frames. The transitions must have passed
+// check_transition when they were read (it is not repeated for every sample).
+Minibatch assemble_minibatch(const replay::ReplayBuffer& replay, const replay::Sample& sample,
+                             const LearnerConfig& config);
+
+// Checks one transition against the learner's settings (voxel count, depth count, index and
+// bin ranges, a finite reward): call it on every transition as it is read, so a wrong input is
+// refused with its position before it can reach a minibatch.
+void check_transition(const stream::Record& transition, const LearnerConfig& config);
+
+}  // namespace qte::learner

@@ -1,0 +1,44 @@
+#include "learner/settings.hpp"
+
+#include <sstream>
+
+#include "common/error.hpp"
+
+namespace qte::learner {
+
+std::string LearnerConfig::json() const {
+  std::ostringstream s;
+  s.precision(17);
+  const voxels::GridBounds& scene = hierarchy.scene;
+  s << "{\"architecture\": \"" << nets::architecture_name(net.architecture) << "\", \"base_channels\": " << net.base_channels
+    << ", \"voxels\": " << hierarchy.voxels() << ", \"depths\": " << hierarchy.depths << ", \"offsets\": [";
+  for (std::size_t i = 0; i < hierarchy.offsets_m.size(); ++i) s << (i ? ", " : "") << hierarchy.offsets_m[i];
+  s << "], \"bounds\": [" << scene.min_corner.x() << ", " << scene.min_corner.y() << ", " << scene.min_corner.z() << ", "
+    << scene.size_m << "], \"batch\": " << batch << ", \"gamma\": " << gamma << ", \"reward_scale\": " << reward_scale
+    << ", \"tau\": " << tau << ", \"learning_rate\": " << learning_rate << ", \"weight_decay\": " << weight_decay
+    << ", \"grad_clip_value\": " << grad_clip_value << ", \"grad_clip_norm\": " << grad_clip_norm
+    << ", \"q_regularisation\": " << q_regularisation << ", \"huber_delta\": " << huber_delta
+    << ", \"tree_target_k\": " << tree_target_k << ", \"n_step\": " << n_step << "}";
+  return s.str();
+}
+
+void LearnerConfig::validate() const {
+  if (batch < 1) throw UsageError("--batch must be at least 1");
+  if (!(gamma >= 0 && gamma <= 1)) throw UsageError("--gamma must be in [0, 1]");
+  if (!(tau >= 0 && tau <= 1)) throw UsageError("--tau must be in [0, 1]");
+  if (!(learning_rate > 0)) throw UsageError("--lr must be positive");
+  if (!(weight_decay >= 0) || !(grad_clip_value >= 0) || !(grad_clip_norm >= 0) || !(q_regularisation >= 0) ||
+      !(huber_delta > 0) || !(reward_scale > 0))
+    throw UsageError("--weight-decay, --grad-clip-value, --grad-clip-norm and --q-reg must be >= 0; "
+                     "--huber-delta, --reward-scale > 0");
+  if (tree_target_k < 0) throw UsageError("--tree-target must be >= 0");
+  if (n_step < 1 || n_step > 10) throw UsageError("--n-step must be 1-10");
+  if (hierarchy.depths < 1 || hierarchy.depths > 8) throw UsageError("--depths must be 1-8");
+  try {
+    hierarchy.validate();
+  } catch (const Error& e) {
+    throw UsageError(std::string("--offset: ") + e.what());
+  }
+}
+
+}  // namespace qte::learner

@@ -1,0 +1,33 @@
+// The learner's settings: every hyper-parameter of C2F-ARM's Q-attention learning, with the
+// published value as default unless the README's table of settings says why not.
+#pragma once
+
+#include <string>
+
+#include "nets/qattention_net.hpp"
+#include "voxels/voxel_grid.hpp"
+
+namespace qte::learner {
+
+struct LearnerConfig {
+  nets::NetConfig net;  // architecture, base channels, voxels, channels, proprio (depth ignored)
+  voxels::CoarseToFine hierarchy;
+  int batch = 32;  // published 128: 4x the cost per step on a CPU (README, settings)
+  double gamma = 0.99;
+  double reward_scale = 0.01;
+  double tau = 0.0025;
+  double learning_rate = 5e-4;
+  double weight_decay = 1e-6;
+  double grad_clip_value = 0.01;  // each gradient element clipped to +-value, per depth (published); 0 = none
+  double grad_clip_norm = 0;      // each depth's gradient L2 norm clipped to this; 0 = none
+  double q_regularisation = 1.0;  // lambda of lambda * mean|Q| (translation; and the head's 218 outputs)
+  double huber_delta = 1.0;
+  int tree_target_k = 0;  // 0: double DQN down the greedy path; K >= 1: tree expansion (online ranks, target values)
+  int n_step = 1;         // bootstrap after n transitions of a chain (the n-step return)
+
+  // The settings a resumed run must share with its checkpoint, as JSON.
+  std::string json() const;
+  void validate() const;  // throws UsageError naming the first bad setting
+};
+
+}  // namespace qte::learner

@@ -1,0 +1,182 @@
+// The bootstrap targets against a brute-force reference written here: Algorithm 2 as a plain
+// recursion, one grid at a time, with the online Q function choosing (the top-K voxels of
+// every non-leaf grid, the leaf voxel, the heads' bins) and the target Q function valuing what
+// it chose (branch values and the max over branches on the target values). The two Q
+// functions disagree, so a target that lets the target network rank, or the online network
+// value, gives other numbers.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "learner/targets.hpp"
+#include "../qattention/random_cloud.hpp"
+
+using namespace qte;
+using namespace qte::qattention;
+
+namespace {
+
+constexpr int V = 16, kCells = V * V * V;
+
+// A Q function of the grid's content alone, irregular enough for no ties; `phase` makes
+// another network of it (online and target disagree everywhere).
+DepthEvaluator content_q(float phase) {
+  return [phase](int depth, const float* grids, const float*, int batch) {
+    nets::QValues out;
+    out.batch = batch;
+    out.translation.resize(static_cast<std::size_t>(batch) * kCells);
+    out.rotation.resize(static_cast<std::size_t>(batch) * 3 * 72);
+    out.gripper.resize(static_cast<std::size_t>(batch) * 2);
+    for (int b = 0; b < batch; ++b) {
+      double sum = 0;
+      for (int cell = 0; cell < kCells; ++cell) {
+        const float* c = grids + (static_cast<std::size_t>(b) * kCells + cell) * voxels::kChannels;
+        out.translation[static_cast<std::size_t>(b) * kCells + cell] =
+            c[9] * std::sin(17 * c[0] + 29 * c[1] + 41 * c[2] + depth + phase) +
+            0.1f * std::cos(13 * c[6] + 7 * c[7] + 5 * c[8] + phase);
+        sum += c[0] + c[1];
+      }
+      for (int i = 0; i < 3 * 72; ++i)
+        out.rotation[static_cast<std::size_t>(b) * 216 + i] = static_cast<float>(std::sin(0.37 * i + sum + phase));
+      out.gripper[b * 2] = static_cast<float>(std::sin(sum + phase));
+      out.gripper[b * 2 + 1] = static_cast<float>(std::cos(sum + 2 * phase));
+    }
+    return out;
+  };
+}
+
+int first_best(const float* q, int count) { return static_cast<int>(std::max_element(q, q + count) - q); }
+
+std::vector<int> k_best(const float* q, int k) {
+  std::vector<int> order(kCells);
+  for (int i = 0; i < kCells; ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return q[a] > q[b]; });
+  order.resize(k);
+  return order;
+}
+
+Eigen::Vector3i voxel_of(int flat) { return {flat / (V * V), (flat / V) % V, flat % V}; }
+
+// What the reference returns for one subtree: its value, and along its best path the value of
+// the subtree at each depth (the per-depth bootstrap values), the target Q of each chosen
+// voxel, and the heads' target values at the online network's bins.
+struct Subtree {
+  float value = 0;
+  std::vector<float> depth_values, q_values;
+  float rotation[3] = {0, 0, 0}, gripper = 0;
+};
+
+Subtree reference(const DepthEvaluator& online, const DepthEvaluator& target, const voxels::CoarseToFine& h,
+                  const voxels::PointCloud& cloud, const std::vector<float>& proprio, int k, int depth,
+                  const voxels::GridBounds& bounds) {
+  std::vector<float> grid(static_cast<std::size_t>(kCells) * voxels::kChannels);
+  voxels::voxelize(cloud, bounds, grid.data());
+  const nets::QValues on = online(depth, grid.data(), proprio.data(), 1);
+  const nets::QValues tg = target(depth, grid.data(), proprio.data(), 1);
+  Subtree best;
+  if (depth + 1 == h.depths) {
+    const int a = first_best(on.translation.data(), kCells);
+    best.value = tg.translation[a];
+    best.depth_values = best.q_values = {tg.translation[a]};
+    for (int axis = 0; axis < 3; ++axis)
+      best.rotation[axis] = tg.rotation[axis * 72 + first_best(on.rotation.data() + axis * 72, 72)];
+    best.gripper = tg.gripper[first_best(on.gripper.data(), 2)];
+    return best;
+  }
+  best.value = -std::numeric_limits<float>::infinity();
+  for (int voxel : k_best(on.translation.data(), k)) {
+    Subtree below = reference(online, target, h, cloud, proprio, k, depth + 1,
+                              h.bounds_at(depth + 1, bounds.centre_of(voxel_of(voxel))));
+    const float value = (tg.translation[voxel] + below.value) / 2;
+    if (value > best.value) {
+      best = below;
+      best.value = value;
+      best.depth_values.insert(best.depth_values.begin(), value);
+      best.q_values.insert(best.q_values.begin(), tg.translation[voxel]);
+    }
+  }
+  return best;
+}
+
+struct Case {
+  learner::LearnerConfig config;
+  std::vector<test_support::RandomCloud> clouds;
+  learner::Minibatch batch;
+  Case(int depths, int tree_k) {
+    config.hierarchy.depths = depths;
+    config.hierarchy.offsets_m = depths == 3 ? std::vector<double>{0.15, 0.05} : std::vector<double>{0.15};
+    config.tree_target_k = tree_k;
+    for (uint32_t seed : {11u, 12u, 13u}) clouds.emplace_back(seed, std::array<uint8_t, 3>{200, 100, 50});
+    batch.size = 3;
+    for (int i = 0; i < 3; ++i) {
+      batch.next_clouds.push_back({clouds[i].xyz, clouds[i].rgb});
+      batch.next_proprio.push_back({1, 0.04f, 0.04f, 0.1f * i});
+    }
+    batch.reward = {0, 0, 100};        // the last one reaches the goal: r * 0.01 = 1 ...
+    batch.discount = {0.99f, 0.5f, 0};  // ... and is terminal
+  }
+};
+
+float bootstrap(const learner::Minibatch& b, int i, float value) {
+  return std::max(0.0f, b.reward[i] * 0.01f + b.discount[i] * value);
+}
+
+}  // namespace
+
+// Tree-expanded targets, K = 1 and 3 over 2 depths and K = 3 over 3 depths: indices from the
+// online network, values from the target network, at every depth and in the heads.
+TEST(BootstrapTargets, TreeExpansionRanksWithTheOnlineNetworkAndValuesWithTheTarget) {
+  const DepthEvaluator online = content_q(0.0f), target = content_q(1.3f);
+  for (auto [depths, k] : {std::pair{2, 1}, std::pair{2, 3}, std::pair{3, 3}}) {
+    SCOPED_TRACE("depths " + std::to_string(depths) + ", K " + std::to_string(k));
+    Case c(depths, k);
+    const learner::Targets t = learner::bootstrap_targets(online, target, c.config, c.batch);
+    bool other_than_target_ranking = false;
+    for (int i = 0; i < c.batch.size; ++i) {
+      const Subtree want = reference(online, target, c.config.hierarchy, c.batch.next_clouds[i].view(),
+                                     c.batch.next_proprio[i], k, 0, c.config.hierarchy.scene);
+      ASSERT_EQ(want.depth_values.size(), static_cast<std::size_t>(depths));
+      for (int d = 0; d < depths; ++d)
+        EXPECT_FLOAT_EQ(t.translation[d][i], bootstrap(c.batch, i, want.depth_values[d])) << "sample " << i << " depth " << d;
+      for (int axis = 0; axis < 3; ++axis)
+        EXPECT_FLOAT_EQ(t.rotation[3 * i + axis], bootstrap(c.batch, i, want.rotation[axis]));
+      EXPECT_FLOAT_EQ(t.gripper[i], bootstrap(c.batch, i, want.gripper));
+      // The target network ranking and valuing alone (the earlier, overestimating target).
+      const Subtree self = reference(target, target, c.config.hierarchy, c.batch.next_clouds[i].view(),
+                                     c.batch.next_proprio[i], k, 0, c.config.hierarchy.scene);
+      if (std::abs(self.value - want.value) > 1e-4f) other_than_target_ranking = true;
+    }
+    EXPECT_TRUE(other_than_target_ranking) << "the case cannot tell who ranks";
+  }
+}
+
+// K = 0 (C2F-ARM): down the online network's greedy path, each depth's own target Q, no averaging.
+TEST(BootstrapTargets, DoubleDqnValuesEachDepthsGreedyVoxelWithTheTargetNetwork) {
+  const DepthEvaluator online = content_q(0.0f), target = content_q(1.3f);
+  Case c(2, 0);
+  const learner::Targets t = learner::bootstrap_targets(online, target, c.config, c.batch);
+  for (int i = 0; i < c.batch.size; ++i) {
+    const Subtree greedy = reference(online, target, c.config.hierarchy, c.batch.next_clouds[i].view(),
+                                     c.batch.next_proprio[i], 1, 0, c.config.hierarchy.scene);
+    for (int d = 0; d < 2; ++d) EXPECT_FLOAT_EQ(t.translation[d][i], bootstrap(c.batch, i, greedy.q_values[d]));
+    EXPECT_FLOAT_EQ(t.gripper[i], bootstrap(c.batch, i, greedy.gripper));
+  }
+}
+
+// --tree-target 1 with one network is the paper's Algorithm 2 with K = 1: the value at depth 0
+// is (q0 + q1) / 2 of the greedy path.
+TEST(BootstrapTargets, TreeTargetOneIsAlgorithmTwoWithKOne) {
+  const DepthEvaluator q = content_q(0.4f);
+  Case c(2, 1);
+  const learner::Targets t = learner::bootstrap_targets(q, q, c.config, c.batch);
+  std::vector<voxels::PointCloud> clouds;
+  for (const auto& cloud : c.batch.next_clouds) clouds.push_back(cloud.view());
+  const auto algorithm2 = expand_batch(q, c.config.hierarchy, clouds, c.batch.next_proprio, 1);
+  for (int i = 0; i < c.batch.size; ++i) {
+    EXPECT_FLOAT_EQ(t.translation[0][i], bootstrap(c.batch, i, algorithm2[i].value));
+    EXPECT_FLOAT_EQ(t.translation[1][i], bootstrap(c.batch, i, algorithm2[i].q_values[1]));
+  }
+  EXPECT_FLOAT_EQ(t.translation[0][2], 1.0f);  // terminal: the scaled reward alone
+}
