@@ -50,11 +50,11 @@ static void run(const cli::Arguments& args) {
   if (!args.has("task")) throw UsageError("--task is required");
   demos::DemoOptions options;
   options.episodes.task = args.text("task");
-  options.episodes.episodes = static_cast<int>(args.integer("episodes"));
-  options.episodes.variation = args.text("variation") == "random" ? -1 : static_cast<int>(args.integer("variation"));
+  options.episodes.episodes = static_cast<int>(args.integer("episodes", 1, 1000000));
+  options.episodes.variation = args.text("variation") == "random" ? -1 : static_cast<int>(args.integer("variation", 0, 1000));
   options.episodes.seed = args.seed();
   options.episodes.scenes = simulator::scene_set_from_name(args.text("scenes"));
-  options.retries = static_cast<int>(args.integer("retries"));
+  options.retries = static_cast<int>(args.integer("retries", 0, 1000));
   options.planner.time_budget_s = args.real("time-budget");
   options.planner.seed = args.seed();
   options.simulator = simulator::options_from_camera_arguments(args.text("cameras"), args.text("image-size"));

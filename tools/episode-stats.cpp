@@ -94,7 +94,7 @@ static void run(const cli::Arguments& args) {
   }
   std::cout << out;
   std::cout.flush();
-  if (!std::cout) throw BrokenPipe();
+  cli::check_standard_output();
 }
 
 int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }

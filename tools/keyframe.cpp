@@ -66,9 +66,9 @@ static cli::Usage usage() {
 
 static void run(const cli::Arguments& args) {
   keyframes::TransitionOptions options;
-  options.augmentation_every_n = static_cast<int>(args.integer("every"));
-  options.hierarchy.scene = voxels::GridBounds::parse(args.text("bounds"), static_cast<int>(args.integer("voxels")));
-  options.hierarchy.depths = static_cast<int>(args.integer("depths"));
+  options.augmentation_every_n = static_cast<int>(args.integer("every", 0, 100000));
+  options.hierarchy.scene = voxels::GridBounds::parse(args.text("bounds"), static_cast<int>(args.integer("voxels", 2, 256)));
+  options.hierarchy.depths = static_cast<int>(args.integer("depths", 1, 8));
   options.hierarchy.offsets_m = voxels::CoarseToFine::parse_offsets(args.text("offset"), options.hierarchy.depths);
   options.crop_augmentation = !args.flag("no-crop-augmentation");
   options.keep_failed = args.flag("keep-failed");

@@ -1,4 +1,6 @@
 // qattn-train: the learner. Replayed transitions in, Q-attention network checkpoints out.
+#include <unistd.h>
+
 #include <iostream>
 
 #include "cli/command.hpp"
@@ -116,12 +118,12 @@ static cli::Usage usage() {
 static void run(const cli::Arguments& args) {
   learner::LearnerConfig config;
   config.net.architecture = nets::architecture_from_name(args.text("architecture"));
-  config.net.base_channels = args.has("base-channels") ? static_cast<int>(args.integer("base-channels"))
+  config.net.base_channels = args.has("base-channels") ? static_cast<int>(args.integer("base-channels", 1, 512))
                                                        : nets::default_base_channels(config.net.architecture);
-  config.hierarchy.scene = voxels::GridBounds::parse(args.text("bounds"), static_cast<int>(args.integer("voxels")));
-  config.hierarchy.depths = static_cast<int>(args.integer("depths"));
+  config.hierarchy.scene = voxels::GridBounds::parse(args.text("bounds"), static_cast<int>(args.integer("voxels", 4, 128)));
+  config.hierarchy.depths = static_cast<int>(args.integer("depths", 1, 8));
   config.hierarchy.offsets_m = voxels::CoarseToFine::parse_offsets(args.text("offset"), config.hierarchy.depths);
-  config.batch = static_cast<int>(args.integer("batch"));
+  config.batch = static_cast<int>(args.integer("batch", 1, 100000));
   config.gamma = args.real("gamma");
   config.reward_scale = args.real("reward-scale");
   config.tau = args.real("tau");
@@ -131,33 +133,36 @@ static void run(const cli::Arguments& args) {
   config.grad_clip_norm = args.real("grad-clip-norm");
   config.q_regularisation = args.real("q-reg");
   config.huber_delta = args.real("huber-delta");
-  config.tree_target_k = static_cast<int>(args.integer("tree-target"));
-  config.n_step = static_cast<int>(args.integer("n-step"));
+  config.tree_target_k = static_cast<int>(args.integer("tree-target", 0, 100000));
+  config.n_step = static_cast<int>(args.integer("n-step", 1, 10));
   config.validate();
+  config.check_memory(static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE)));
   if (!args.has("checkpoint-dir")) throw UsageError("--checkpoint-dir is required");
 
   learner::LoopOptions loop;
-  loop.steps = args.integer("steps");
-  loop.start_after = args.integer("start-after");
-  loop.pretrain = args.integer("pretrain");
+  loop.steps = args.integer("steps", 0, 1000000000000);
+  loop.start_after = args.integer("start-after", 0, 1000000000000);
+  loop.pretrain = args.integer("pretrain", 0, 1000000000000);
   loop.replay_ratio = args.real("replay-ratio");
   loop.beta = args.real("beta");
   loop.follow = args.flag("follow");
   loop.stop_file = args.text("stop-file");
-  loop.checkpoint_every = args.integer("checkpoint-every");
-  loop.log_every = args.integer("log-every");
+  loop.checkpoint_every = args.integer("checkpoint-every", 1, 1000000000000);
+  loop.log_every = args.integer("log-every", 1, 1000000000000);
   loop.metrics_path = args.text("metrics");
   loop.seed = args.seed();
+  loop.threads = static_cast<int>(args.integer("threads", 1, 256));
+  if (loop.threads < 1 || loop.threads > 256) throw UsageError("--threads must be 1-256");
   replay::ReplayOptions replay_options;
-  replay_options.capacity = static_cast<std::size_t>(std::max<int64_t>(1, args.integer("capacity")));
+  replay_options.capacity = static_cast<std::size_t>(std::max<int64_t>(1, args.integer("capacity", 1, 1000000000)));
   replay_options.prioritised = !args.flag("uniform");
   replay_options.alpha = args.real("alpha");
 
-  nets::set_torch_threads(static_cast<int>(args.integer("threads")));
+  nets::set_torch_threads(loop.threads);
   nets::seed_torch(loop.seed);
   learner::QLearner learner(config);
   replay::ReplayBuffer replay(replay_options);
-  learner::CheckpointDirectory checkpoints(args.text("checkpoint-dir"), static_cast<int>(args.integer("keep")));
+  learner::CheckpointDirectory checkpoints(args.text("checkpoint-dir"), static_cast<int>(args.integer("keep", 1, 100000)));
   learner::InputFollower inputs(args.positional(), loop.follow);
   learner::TrainingLoop training(learner, replay, inputs, checkpoints, loop, std::cerr);
   training.start(args.flag("resume"));

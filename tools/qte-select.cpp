@@ -5,10 +5,10 @@
 #include <cerrno>
 #include <cmath>
 #include <iostream>
+#include <optional>
 #include <random>
 
 #include "cli/command.hpp"
-#include "voxels/grid_fields.hpp"
 #include "common/random.hpp"
 #include "nets/qattention_net.hpp"
 #include "qattention/acting.hpp"
@@ -16,6 +16,7 @@
 #include "qattention/proprio.hpp"
 #include "stream/reader.hpp"
 #include "stream/writer.hpp"
+#include "voxels/grid_fields.hpp"
 #include "voxels/observation_cloud.hpp"
 
 using namespace qte;
@@ -116,9 +117,9 @@ double non_negative(const cli::Arguments& args, const std::string& name) {
 static void run(const cli::Arguments& args) {
   const std::string checkpoint = args.text("checkpoint");
   if (checkpoint.empty()) throw UsageError("--checkpoint FILE is required");
-  const int64_t k = args.integer("k");
+  const int64_t k = args.integer("k", 1, 4096);
   if (k < 1) throw UsageError("--k must be at least 1");
-  const int64_t threads = args.integer("threads");
+  const int64_t threads = args.integer("threads", 1, 256);
   if (threads < 1) throw UsageError("--threads must be at least 1");
   qattention::Exploration exploration;
   exploration.epsilon = probability(args, "epsilon");
@@ -179,9 +180,19 @@ static void run(const cli::Arguments& args) {
       std::cerr << "qte-select: loaded checkpoint " << checkpoint << " at training step " << networks.step()
                 << std::endl;
     const std::vector<float> proprio = qattention::proprio_of(*record, step);
+    for (float p : proprio)
+      if (!std::isfinite(p)) record->fail("gripper_opening_m", "a finite gripper opening");
     std::mt19937_64 rng(derive_seed(args.seed(), actions));
-    qattention::Action action =
-        qattention::act(evaluate, hierarchy, observed.view(), proprio, static_cast<int>(k), exploration, rng);
+    std::optional<qattention::Action> chosen;
+    try {
+      chosen.emplace(
+          qattention::act(evaluate, hierarchy, observed.view(), proprio, static_cast<int>(k), exploration, rng));
+    } catch (const StreamError&) {
+      throw;
+    } catch (const Error& e) {  // a diverged checkpoint: name the observation it failed on
+      throw StreamError(record->position, std::string(e.what()) + " (checkpoint " + checkpoint + ")");
+    }
+    qattention::Action& action = *chosen;
     if (!png_dir.empty()) qattention::save_q_pictures(png_dir, actions, action);
     writer.write(qattention::action_record(action.choice, ignore_collisions, static_cast<int>(k), action.explored,
                                            networks.step(), step));

@@ -20,8 +20,9 @@ static cli::Usage usage() {
       "every camera's RGB, metric depth, intrinsics, extrinsics and world-frame point cloud; "
       "joint positions and velocities, gripper open flag and pose, step index; reward (100 on "
       "success), terminal, success, and the failure reason of the last action if any.",
-      "A trajectory that does not start at the current joint positions, holds NaNs, leaves the "
-      "joint limits, exceeds the joint speed limit, or makes the arm touch the table or itself "
+      "A trajectory that does not start at the current joint positions, holds NaNs, lasts "
+      "longer than 60 s, leaves the joint limits, exceeds the joint speed limit, or makes the "
+      "arm touch the table or itself "
       "fails: the episode ends with reward 0 and the reason in the observation's 'failure' "
       "field, as an invalid action does in RLBench. An episode also ends after 10 next-best "
       "poses. With --task, sim-step starts episodes by itself (the next one after each terminal "
@@ -68,15 +69,15 @@ static void run(const cli::Arguments& args) {
   options.observe_every_step = args.flag("every-step");
   options.point_clouds = !args.flag("no-points");
   options.compress_images = args.flag("compress");
-  options.render_threads = static_cast<int>(args.integer("threads"));
+  options.render_threads = static_cast<int>(args.integer("threads", 1, 256));
   if (options.render_threads < 1) throw UsageError("--threads must be at least 1");
 
   const robot::RobotModel robot = robot::RobotModel::xarm7();
   simulator::Simulator simulator(robot, options);
   std::optional<simulator::EpisodePlan> plan;
   if (args.has("task")) {
-    plan = simulator::EpisodePlan{args.text("task"), 0, static_cast<int>(args.integer("episodes")), args.seed()};
-    plan->variation = args.text("variation") == "random" ? -1 : static_cast<int>(args.integer("variation"));
+    plan = simulator::EpisodePlan{args.text("task"), 0, static_cast<int>(args.integer("episodes", 1, 10000000)), args.seed()};
+    plan->variation = args.text("variation") == "random" ? -1 : static_cast<int>(args.integer("variation", 0, 1000));
     plan->scenes = simulator::scene_set_from_name(args.text("scenes"));
     tasks::make_task(plan->task);  // an unknown task fails before anything is written
   }

@@ -67,7 +67,7 @@ static void run(const cli::Arguments& args) {
   const auto keep = args.all("type"), drop = args.all("exclude");
   const std::set<std::string> keep_types(keep.begin(), keep.end()),
       drop_types(drop.begin(), drop.end());
-  const int64_t head = args.integer("head");
+  const int64_t head = args.integer("head", -1, 1000000000000000);
   std::vector<Condition> conditions;
   for (const std::string& where : args.all("where")) {
     const auto eq = where.find('=');

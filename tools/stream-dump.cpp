@@ -51,7 +51,7 @@ static cli::Usage usage() {
 // Stops at once when the reader of our output has gone (e.g. `stream-dump | head`).
 static void flush_or_stop() {
   std::cout.flush();
-  if (!std::cout) throw BrokenPipe();
+  cli::check_standard_output();
 }
 
 static void run(const cli::Arguments& args) {
@@ -60,7 +60,7 @@ static void run(const cli::Arguments& args) {
   const auto wanted = args.all("type");
   const std::set<std::string> types(wanted.begin(), wanted.end());
   stream::InspectOptions inspect;
-  inspect.max_values = args.flag("all-values") ? -1 : args.integer("values");
+  inspect.max_values = args.flag("all-values") ? -1 : args.integer("values", -1, 1000000000);
   const std::string npy_dir = args.text("npy");
   if (!npy_dir.empty() && ::mkdir(npy_dir.c_str(), 0755) != 0 && errno != EEXIST)
     throw_system_error("cannot create directory " + npy_dir);

@@ -40,7 +40,7 @@ static void run(const cli::Arguments& args) {
   std::vector<std::string> files = args.positional();
   if (files.empty()) files.push_back("-");
   const std::string dir = args.text("dir"), type = args.text("type");
-  const int64_t every = args.integer("every");
+  const int64_t every = args.integer("every", 1, 1000000000);
   if (every < 1) throw UsageError("--every must be at least 1");
   if (::mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) throw_system_error("cannot create directory " + dir);
   int64_t seen = 0;

@@ -73,7 +73,7 @@ static std::vector<double> numbers(const std::string& option, const std::string&
 }
 
 static void run(const cli::Arguments& args) {
-  const voxels::GridBounds scene = voxels::GridBounds::parse(args.text("bounds"), static_cast<int>(args.integer("voxels")));
+  const voxels::GridBounds scene = voxels::GridBounds::parse(args.text("bounds"), static_cast<int>(args.integer("voxels", 2, 256)));
   if (scene.voxels > 256) throw UsageError("--voxels must be 2-256");
   const double offset = args.real("offset");
   std::vector<voxels::GridBounds> crops;

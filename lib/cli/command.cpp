@@ -1,9 +1,13 @@
 #include "cli/command.hpp"
 
 #include <signal.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <iostream>
 #include <sstream>
 
@@ -125,6 +129,13 @@ int64_t Arguments::integer(const std::string& name) const {
   } catch (const std::exception&) {
   }
   throw UsageError("--" + name + ": expected an integer, got '" + v + "'");
+}
+
+int64_t Arguments::integer(const std::string& name, int64_t lo, int64_t hi) const {
+  const int64_t n = integer(name);
+  if (n < lo || n > hi)
+    throw UsageError("--" + name + " must be " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " + text(name));
+  return n;
 }
 
 double Arguments::real(const std::string& name) const {
@@ -258,6 +269,17 @@ std::string man_page(const Usage& usage) {
   return out;
 }
 
+void check_standard_output() {
+  const int error = errno;
+  if (std::cout.flush()) return;
+  // Only a reader that went away is a closed pipe (exit 141, quietly); a full disk or
+  // /dev/full is an error to report.
+  struct stat info {};
+  if (::fstat(STDOUT_FILENO, &info) == 0 && (S_ISFIFO(info.st_mode) || S_ISSOCK(info.st_mode))) throw BrokenPipe();
+  throw Error(std::string("cannot write standard output") +
+              (errno != error && errno != 0 ? std::string(": ") + std::strerror(errno) : std::string()));
+}
+
 int run_tool(int argc, char** argv, const Usage& usage,
              const std::function<void(const Arguments&)>& run) {
   // EPIPE arrives as an error from write() instead of killing the process; see BrokenPipe.
@@ -278,7 +300,7 @@ int run_tool(int argc, char** argv, const Usage& usage,
       return 0;
     }
     run(args);
-    std::cout.flush();
+    check_standard_output();
     return 0;
   } catch (const BrokenPipe&) {
     return 141;

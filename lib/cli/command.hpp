@@ -50,6 +50,8 @@ class Arguments {
   bool has(const std::string& name) const;  // given on the command line
   std::string text(const std::string& name) const;
   int64_t integer(const std::string& name) const;
+  // The same, refused with a UsageError outside lo..hi (no value wraps when a tool narrows it).
+  int64_t integer(const std::string& name, int64_t lo, int64_t hi) const;
   double real(const std::string& name) const;
   std::vector<std::string> all(const std::string& name) const;  // repeatable options
   const std::vector<std::string>& positional() const { return positional_; }
@@ -67,6 +69,10 @@ Arguments parse(const Usage& usage, const std::vector<std::string>& argv);
 
 std::string help_text(const Usage& usage);
 std::string man_page(const Usage& usage);  // roff, section 1
+
+// Flushes standard output; a failed write throws BrokenPipe when the reader of a pipe went
+// away (exit 141) and Error otherwise (a full disk: one line, exit 1).
+void check_standard_output();
 
 // main() of every tool: `return run_tool(argc, argv, usage(), run);`
 // Exit status: 0 success, 1 error (one line on stderr), 2 usage error, 141 broken pipe.

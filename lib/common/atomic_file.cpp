@@ -7,6 +7,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <mutex>
 
 #include "common/error.hpp"
@@ -72,8 +73,28 @@ void write_all(int fd, const void* data, std::size_t n, const std::string& what)
   }
 }
 
+int remove_stale_temporaries(const std::string& dir, const std::string& name) {
+  std::error_code error;
+  int removed = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.empty() ? "." : dir, error)) {
+    const std::string file = entry.path().filename().string();
+    const std::size_t tmp = file.rfind(".tmp.");
+    if (tmp == std::string::npos || tmp == 0 || (!name.empty() && file.compare(0, tmp, name) != 0) ||
+        (!name.empty() && tmp != name.size()))
+      continue;
+    const std::string digits = file.substr(tmp + 5);
+    if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    const pid_t pid = static_cast<pid_t>(std::stol(digits));
+    if (pid == ::getpid() || ::kill(pid, 0) == 0 || errno != ESRCH) continue;  // its writer may still be at work
+    if (std::filesystem::remove(entry.path(), error)) ++removed;
+  }
+  return removed;
+}
+
 AtomicOutputFile::AtomicOutputFile(std::string path)
     : path_(std::move(path)), temp_path_(path_ + ".tmp." + std::to_string(::getpid())) {
+  const std::filesystem::path p(path_);
+  remove_stale_temporaries(p.parent_path().string(), p.filename().string());
   struct stat info {};
   if (::stat(path_.c_str(), &info) == 0 && !S_ISREG(info.st_mode)) {
     fd_ = ::open(path_.c_str(), O_WRONLY | O_CLOEXEC);

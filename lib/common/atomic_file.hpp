@@ -34,6 +34,11 @@ class AtomicOutputFile {
 // EPIPE, Error otherwise; `what` names the destination in the message.
 void write_all(int fd, const void* data, std::size_t n, const std::string& what);
 
+// Removes what a killed writer left: files in `dir` named <name>.tmp.<pid> whose process is
+// gone, for <name> `name` (or any name when `name` is empty). A SIGKILL gives no chance to
+// clean up, so the next program writing there does. Returns how many it removed.
+int remove_stale_temporaries(const std::string& dir, const std::string& name = "");
+
 // Convenience: the whole file at once, atomically.
 void write_file_atomically(const std::string& path, const void* data, std::size_t n);
 

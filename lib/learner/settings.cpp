@@ -1,5 +1,6 @@
 #include "learner/settings.hpp"
 
+#include <algorithm>
 #include <sstream>
 
 #include "common/error.hpp"
@@ -39,6 +40,31 @@ void LearnerConfig::validate() const {
   } catch (const Error& e) {
     throw UsageError(std::string("--offset: ") + e.what());
   }
+}
+
+double LearnerConfig::step_memory_bytes() const {
+  const double v = hierarchy.voxels(), cells = v * v * v;
+  const double grid_bytes = cells * (voxels::kChannels + 1) * sizeof(float);  // a grid and its Q volume
+  const bool arm = net.architecture == nets::Architecture::arm;
+  const double per_sample = (arm ? 80e6 : 6e6) * (cells / 4096.0) *
+                            (static_cast<double>(net.base_channels) / nets::default_base_channels(net.architecture));
+  double branches = 1, target_grids = 0;  // per sample: grids of every depth of the target's tree
+  for (int d = 0; d < hierarchy.depths; ++d) {
+    target_grids += branches;
+    branches *= std::min<double>(std::max(1, tree_target_k), cells);
+  }
+  return batch * (per_sample + 2 * target_grids * grid_bytes) + 4e8;  // 2: online and target outputs; 0.4 GB base
+}
+
+void LearnerConfig::check_memory(double available_bytes) const {
+  const double need = step_memory_bytes();
+  if (need <= 0.8 * available_bytes) return;
+  std::ostringstream s;
+  s.precision(3);
+  s << "--batch " << batch << " with --tree-target " << tree_target_k << " (" << hierarchy.depths << " depths of "
+    << hierarchy.voxels() << "^3, " << nets::architecture_name(net.architecture) << " networks) needs about "
+    << need / 1e9 << " GB per step; this machine has " << available_bytes / 1e9 << " GB";
+  throw UsageError(s.str());
 }
 
 }  // namespace qte::learner

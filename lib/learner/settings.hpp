@@ -28,6 +28,12 @@ struct LearnerConfig {
   // The settings a resumed run must share with its checkpoint, as JSON.
   std::string json() const;
   void validate() const;  // throws UsageError naming the first bad setting
+  // Rough peak memory of one learner step, bytes: the networks' activations for the batch
+  // (measured per sample at 16^3: light ~6 MB, arm ~80 MB; scaled by base channels and grid
+  // size) and the tree target's grids of every branch.
+  double step_memory_bytes() const;
+  // Throws UsageError when a step would need more than `available_bytes` (the machine's memory).
+  void check_memory(double available_bytes) const;
 };
 
 }  // namespace qte::learner

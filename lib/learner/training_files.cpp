@@ -11,6 +11,7 @@
 #include <mutex>
 #include <thread>
 
+#include "common/atomic_file.hpp"
 #include "common/error.hpp"
 #include "replay/growing_stream.hpp"
 #include "stream/reader.hpp"
@@ -95,6 +96,7 @@ CheckpointDirectory::CheckpointDirectory(std::string dir, int keep) : dir_(std::
   std::error_code error;
   std::filesystem::create_directories(dir_, error);
   if (error) throw Error("cannot create checkpoint directory " + dir_ + ": " + error.message());
+  remove_stale_temporaries(dir_);  // step-N.rec.tmp.PID of a run killed while it wrote
 }
 
 std::string CheckpointDirectory::path_for(int64_t step) const {

@@ -97,6 +97,7 @@ void TrainingLoop::save() {
   state.set_scalar<int64_t>("transitions_read", transitions_read_);
   state.set_scalar<int64_t>("agent_transitions", agent_transitions_);
   state.set_scalar<int64_t>("seed", static_cast<int64_t>(options_.seed));
+  state.set_scalar<int64_t>("threads", options_.threads);
   const std::vector<double> priorities = replay_.priorities();
   state.set<double>("priorities", {static_cast<int64_t>(priorities.size())}, priorities, /*compress=*/true);
   state.set_scalar<double>("max_priority", replay_.max_priority());
@@ -110,6 +111,13 @@ bool TrainingLoop::start(bool resume) {
   bool resumed = false;
   if (resume && exists(checkpoints_.latest())) {
     const stream::Record state = learner_.load(checkpoints_.latest());
+    // Another seed or thread count would continue as another run (other batches, other sums).
+    for (const auto& [name, value] : {std::pair<const char*, int64_t>{"seed", static_cast<int64_t>(options_.seed)},
+                                      std::pair<const char*, int64_t>{"threads", options_.threads}})
+      if (state.has(name) && state.scalar<int64_t>(name) != value)
+        throw UsageError(checkpoints_.latest() + ": the run was started with --" + name + " " +
+                         std::to_string(state.scalar<int64_t>(name)) + "; resume it with the same, not " +
+                         std::to_string(value));
     const int64_t want = state.scalar<int64_t>("transitions_read");
     while (true) {  // the inputs up to where the checkpoint was taken
       ingest(INT64_MAX, false, want);

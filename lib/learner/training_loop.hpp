@@ -35,6 +35,7 @@ struct LoopOptions {
   int64_t log_every = 10;
   std::string metrics_path;      // CSV; empty: none
   uint64_t seed = 0;
+  int threads = 2;  // LibTorch's: floating-point sums differ with it, so a resume must keep it
   std::chrono::milliseconds poll{200};
 };
 

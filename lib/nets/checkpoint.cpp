@@ -113,17 +113,24 @@ void save_checkpoint(const std::string& path, const std::vector<QAttentionNet>& 
 CheckpointConfig checkpoint_config(const stream::Record& record) {
   if (record.type() != "checkpoint")
     throw StreamError(record.position, "expected a 'checkpoint' record, got '" + record.type() + "'");
-  const auto integer = [&](const char* name) { return static_cast<int>(record.scalar<int64_t>(name)); };
+  // Checked before anything is built from them: a damaged or hostile count would otherwise ask
+  // for networks of terabytes.
+  const auto integer = [&](const char* name, int64_t lo, int64_t hi) {
+    const int64_t v = record.scalar<int64_t>(name);
+    if (v < lo || v > hi)
+      record.fail(name, std::to_string(lo) + ".." + std::to_string(hi) + ", got " + std::to_string(v));
+    return static_cast<int>(v);
+  };
   CheckpointConfig config;
   const std::string architecture = record.string("architecture");
   if (architecture != "arm" && architecture != "light")
     throw StreamError(record.position, "'checkpoint' record: unknown architecture '" + architecture + "'");
   config.net.architecture = architecture_from_name(architecture);
-  config.net.base_channels = integer("base_channels");
-  config.net.voxels = integer("voxels");
-  config.net.channels = integer("channels");
-  config.net.proprio = integer("proprio");
-  config.depths = integer("depths");
+  config.net.base_channels = integer("base_channels", 1, 512);
+  config.net.voxels = integer("voxels", 4, 128);
+  config.net.channels = integer("channels", 1, 64);
+  config.net.proprio = integer("proprio", 1, 64);
+  config.depths = integer("depths", 1, 8);
   config.net.is_last = config.depths == 1;
   config.step = record.scalar<int64_t>("step");
   return config;

@@ -324,6 +324,14 @@ cv::Mat draw_curves(const std::vector<Curve>& curves, const CurvePlotOptions& op
       x_lo = std::min(x_lo, p.x), x_hi = std::max(x_hi, p.x);
       y_lo = std::min({y_lo, p.mean, p.low}), y_hi = std::max({y_hi, p.mean, p.high});
     }
+  // Values near the ends of the double range have no finite extent to draw (ticks would never end).
+  const auto check_extent = [](const char* axis, double lo, double hi) {
+    if (!std::isfinite(hi - lo) || !std::isfinite(0.04 * (hi - lo) + hi) || !std::isfinite(lo - 0.04 * (hi - lo)))
+      throw Error(std::string("the ") + axis + " values span " + std::to_string(lo) + " to " + std::to_string(hi) +
+                  ": more than a plot can draw");
+  };
+  check_extent("x", x_lo, x_hi);
+  check_extent("y", options.fixed_y ? options.y_min : y_lo, options.fixed_y ? options.y_max : y_hi);
   Axis y_axis = data_axis(y_lo, y_hi);
   if (options.fixed_y) {
     y_axis.lo = options.y_min;

@@ -149,6 +149,8 @@ std::string Simulator::check_trajectory(const stream::Record& record) const {
   for (int64_t i = 0; i < n; ++i)
     if (!std::isfinite(times[i]) || (i > 0 && times[i] <= times[i - 1]) || (i == 0 && times[0] != 0))
       return "invalid_trajectory:time_s must start at 0 and increase";
+  if (times[n - 1] > options_.max_trajectory_s)
+    return "invalid_trajectory:longer than " + std::to_string(static_cast<int>(options_.max_trajectory_s)) + " s";
   const robot::JointVector lo = robot_.lower_limits(), hi = robot_.upper_limits(),
                            vmax = robot_.max_velocities();
   for (int k = 0; k < robot::kArmJoints; ++k)

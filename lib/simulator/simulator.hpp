@@ -29,6 +29,9 @@ struct SimulatorOptions {
   bool point_clouds = true;           // include <camera>.points in observations
   bool observe_every_step = false;    // also emit an obs at every control step of a trajectory
   double control_period_s = 0.05;     // 20 Hz control steps along trajectories
+  // The longest trajectory one next-best pose may take: the arm crosses its workspace at full
+  // speed in about 2 s; a longer one fails the action rather than run for minutes.
+  double max_trajectory_s = 60.0;
   int render_threads = 2;
   bool compress_images = false;       // zstd on rgb/depth/points (for files on disk)
 };

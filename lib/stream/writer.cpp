@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "stream/codec.hpp"
@@ -34,11 +35,19 @@ void RecordWriter::write(const Record& record) {
   } else if (fd_ < 0) {
     throw Error("write to " + path_ + " after close");
   } else if (options_.mode == WriteMode::append && fd_ != 1) {
-    // One lock per record keeps records of concurrent appenders from interleaving.
+    // One lock per record keeps records of concurrent appenders from interleaving. A record
+    // is appended whole or not at all: a failed write (a full disk) is cut back to where the
+    // file ended, so the next append does not land behind a torn record that every reader
+    // would stop at.
     if (::flock(fd_, LOCK_EX) != 0) throw_system_error("cannot lock " + path_);
+    struct stat before {};
+    const bool sized = ::fstat(fd_, &before) == 0;
     try {
       write_all(fd_, bytes.data(), bytes.size(), path_);
     } catch (...) {
+      if (sized && ::ftruncate(fd_, before.st_size) != 0) {
+        // Nothing more to do: the write's own error is the one to report.
+      }
       ::flock(fd_, LOCK_UN);
       throw;
     }

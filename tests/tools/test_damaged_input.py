@@ -87,6 +87,25 @@ r = tool("stream-pack", "reset", "x=@" + os.path.join(tmp, "missing.npy"))
 if r.returncode != 1 or b"missing.npy" not in r.stderr:
     failures.append(f"missing input file: exit {r.returncode}, {r.stderr!r}")
 
+# .npy headers whose shape is not an array a record can hold: refused, not wrapped or misread.
+def npy(shape_text, data=b""):
+    header = ("{'descr': '<f4', 'fortran_order': False, 'shape': " + shape_text + ", }").encode()
+    header += b" " * (63 - (10 + len(header)) % 64) + b"\n"
+    return b"\x93NUMPY\x01\x00" + struct.pack("<H", len(header)) + header + data
+for shape_text, data in [("(-1,)", b"\0" * 4), ("(4294967296, 4294967296, 4)", b""), ("(2, x)", b""),
+                         ("(99999999999999999999,)", b"")]:
+    path = os.path.join(tmp, "bad.npy")
+    with open(path, "wb") as f:
+        f.write(npy(shape_text, data))
+    r = tool("stream-pack", "reset", "x=@" + path)
+    if r.returncode != 1 or b"bad.npy" not in r.stderr or r.stdout:
+        failures.append(f".npy shape {shape_text}: exit {r.returncode}, {r.stderr!r}, {len(r.stdout)} bytes out")
+with open(os.path.join(tmp, "good.npy"), "wb") as f:
+    f.write(npy("(2,)", struct.pack("<2f", 1.5, 2.5)))
+r = tool("stream-pack", "reset", "x=@" + os.path.join(tmp, "good.npy"))
+if r.returncode != 0:
+    failures.append(f"a good .npy was refused: {r.stderr!r}")
+
 # Good input still passes, byte for byte.
 r = tool("stream-cat", "-", stdin=good)
 if r.returncode != 0 or r.stdout != good:

@@ -15,6 +15,12 @@ rc=${PIPESTATUS[0]}
 err=$(timeout 10 stream-dump "$tmp/many.rec" 2>"$tmp/err" | head -n 1 >/dev/null; cat "$tmp/err")
 [ -z "$err" ] || fail "stream-dump complained about a closed pipe: $err"
 
+# A write error that is not a closed pipe (a full disk) is one line and exit 1, never a quiet 141.
+for tool in "stream-dump $tmp/many.rec" "stream-dump --json $tmp/many.rec" "stream-dump --summary $tmp/many.rec"; do
+  err=$($tool 2>&1 >/dev/full); rc=$?
+  [ "$rc" = 1 ] && grep -q "cannot write standard output" <<<"$err" || fail "$tool > /dev/full: exit $rc: $err"
+done
+
 # Appending from several writers keeps every record whole.
 for w in 1 2 3 4; do stream-cat "$tmp/many.rec" --append --output "$tmp/replay.rec" & done; wait
 [ "$(stream-dump --summary "$tmp/replay.rec" | cut -f2)" = "200 records" ] || fail "concurrent append"

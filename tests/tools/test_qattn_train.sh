@@ -29,6 +29,15 @@ grep -q "resumed at step 3" "$tmp/b.log" || fail "$(cat "$tmp/b.log")"
 cmp -s "$tmp/a/latest.rec" "$tmp/b/latest.rec" || fail "a resumed run differs from an uninterrupted one"
 [ "$(cut -d, -f1 "$tmp/b.csv" | tr '\n' ' ')" = "step 2 3 4 6 " ] || fail "resumed metrics: $(cat "$tmp/b.csv")"
 
+# Another seed or thread count would resume as another run: refused.
+err=$(qattn-train --batch 4 --start-after 4 --seed 6 --steps 6 --checkpoint-every 3 --checkpoint-dir "$tmp/b" --resume \
+  "$tmp/tr.rec" 2>&1) \
+  && fail "resumed with another seed"
+grep -q "started with --seed 5; resume it with the same, not 6" <<<"$err" || fail "$err"
+err=$(train --steps 6 --checkpoint-every 3 --checkpoint-dir "$tmp/b" --resume --threads 1 "$tmp/tr.rec" 2>&1) \
+  && fail "resumed with another thread count"
+grep -q "started with --threads 2; resume it with the same, not 1" <<<"$err" || fail "$err"
+
 # Killed mid-run: the last checkpoint is whole and the run resumes from it.
 train --steps 1000 --checkpoint-every 2 --checkpoint-dir "$tmp/k" "$tmp/tr.rec" 2>/dev/null &
 pid=$!

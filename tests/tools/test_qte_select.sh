@@ -183,6 +183,13 @@ err=$(qte-select --checkpoint "$ckpt" --offset 0.1 < "$tmp/in.rec" 2>&1 >/dev/nu
   || fail "other --offset: exit $rc: $err"
 qte-select --checkpoint "$ckpt" --bounds=-0.3,-0.5,0.6,1.0 --offset 0.15 --seed 5 "$tmp/in.rec" | cmp -s - "$tmp/greedy.rec" \
   || fail "the checkpoint's own --bounds and --offset changed the actions"
+# Integers that would wrap when narrowed are refused (4294967297 used to run as k = 1).
+err=$(qte-select --checkpoint "$ckpt" --k 4294967297 < "$tmp/in.rec" 2>&1 >/dev/null); rc=$?
+[ $rc = 2 ] && grep -q -- "--k must be 1..4096, got 4294967297" <<<"$err" || fail "--k 2^32 + 1: exit $rc: $err"
+err=$(demo-record --task reach_target --episodes 4294967297 --output "$tmp/x.rec" 2>&1); rc=$?
+[ $rc = 2 ] && grep -q -- "--episodes must be 1..1000000" <<<"$err" || fail "--episodes 2^32 + 1: exit $rc: $err"
+err=$(voxelize --voxels 4294967312 < "$tmp/in.rec" 2>&1 >/dev/null); rc=$?
+[ $rc = 2 ] && grep -q -- "--voxels must be 2..256" <<<"$err" || fail "--voxels 2^32 + 16: exit $rc: $err"
 err=$(qte-select < "$tmp/in.rec" 2>&1 >/dev/null); rc=$?
 [ $rc = 2 ] && grep -q -- "--checkpoint FILE is required" <<<"$err" || fail "no --checkpoint: exit $rc: $err"
 err=$(stream-pack obs step:i32=0 terminal:u8=0 | qte-select --checkpoint "$ckpt" 2>&1 >/dev/null); rc=$?

@@ -2,6 +2,7 @@
 #include <unistd.h>
 
 #include <sys/stat.h>
+#include <sys/wait.h>
 
 #include <fstream>
 #include <iterator>
@@ -86,4 +87,30 @@ TEST(AtomicFile, DevicesAndPipesAreWrittenInPlaceNotReplaced) {
   reader.join();
   ASSERT_EQ(::stat(fifo.c_str(), &info), 0);
   EXPECT_TRUE(S_ISFIFO(info.st_mode));
+}
+
+// A SIGKILL leaves NAME.tmp.PID behind; the next writer of NAME removes it (and a checkpoint
+// directory all of them), but never one whose process still runs.
+TEST(AtomicFile, StaleTemporariesOfDeadWritersAreRemoved) {
+  const std::string dir = temp_dir();
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  int status = 0;
+  ::waitpid(child, &status, 0);  // a pid whose process is gone
+  const std::string dead = std::to_string(child), alive = std::to_string(::getppid());
+  for (const std::string& name : {"out.rec.tmp." + dead, "out.rec.tmp." + alive, "other.rec.tmp." + dead,
+                                 "step-00000003.rec.tmp." + dead, std::string("notes.tmp.txt")})
+    std::ofstream(dir + "/" + name) << "x";
+  {
+    AtomicOutputFile f(dir + "/out.rec");
+    f.write("abc", 3);
+    f.commit();
+  }
+  EXPECT_FALSE(exists(dir + "/out.rec.tmp." + dead));
+  EXPECT_TRUE(exists(dir + "/out.rec.tmp." + alive));
+  EXPECT_TRUE(exists(dir + "/other.rec.tmp." + dead));  // another output's: not this writer's to judge
+  EXPECT_EQ(remove_stale_temporaries(dir), 2);         // a checkpoint directory: every dead writer's
+  EXPECT_FALSE(exists(dir + "/step-00000003.rec.tmp." + dead));
+  EXPECT_TRUE(exists(dir + "/out.rec.tmp." + alive));
+  EXPECT_TRUE(exists(dir + "/notes.tmp.txt"));
 }

@@ -266,6 +266,16 @@ std::vector<float> gradient_values(const std::vector<nets::QAttentionNet>& nets,
 
 double huber(double x) { return std::abs(x) < 1 ? 0.5 * x * x : std::abs(x) - 0.5; }
 
+// A learner of `config` with weights from `seed`, and the tiny replay as one batch.
+struct Seeded {
+  replay::ReplayBuffer replay;
+  learner::QLearner trainer;
+  learner::Minibatch batch;
+  Seeded(const learner::LearnerConfig& config, uint64_t seed)
+      : replay(tiny_replay(config)), trainer((nets::set_torch_threads(2), nets::seed_torch(seed), config)),
+        batch(learner::assemble_minibatch(replay, all_of(replay), config)) {}
+};
+
 }  // namespace
 
 // Published: every gradient element clipped to +-0.01, each depth's network on its own.
@@ -273,12 +283,11 @@ TEST(QLearner, GradientsAreClippedByValuePerDepth) {
   nets::set_torch_threads(2);
   for (double clip : {0.0, 0.01}) {
     SCOPED_TRACE("clip " + std::to_string(clip));
-    nets::seed_torch(17);
     learner::LearnerConfig config = small_config();
     config.grad_clip_value = clip;
-    learner::QLearner learner(config);
-    replay::ReplayBuffer replay = tiny_replay(config);
-    learner.gradients(learner::assemble_minibatch(replay, all_of(replay), config));
+    Seeded s(config, 17);
+    s.trainer.gradients(s.batch);
+    const learner::QLearner& learner = s.trainer;
     for (int d = 0; d < 2; ++d) {
       const std::vector<float> g = gradient_values(learner.online(), d);
       ASSERT_FALSE(g.empty());
@@ -303,13 +312,11 @@ TEST(QLearner, GradientsAreClippedByValuePerDepth) {
 // lambda * (mean |translation Q| + at the last depth mean |the head's 218 outputs|), weighted
 // by the importance weights, then the batch mean.
 TEST(QLearner, LossIsOneMeanOverFiveTermsAndRegularisedWithImportanceWeights) {
-  nets::set_torch_threads(2);
-  nets::seed_torch(19);
   learner::LearnerConfig config = small_config();
   config.q_regularisation = 0.7;
-  learner::QLearner learner(config);
-  replay::ReplayBuffer replay = tiny_replay(config);
-  learner::Minibatch batch = learner::assemble_minibatch(replay, all_of(replay), config);
+  Seeded s(config, 19);
+  learner::QLearner& learner = s.trainer;
+  learner::Minibatch& batch = s.batch;
   batch.weights = {1.0, 0.5, 0.25, 0.75};
   const learner::Targets targets = learner.targets(batch);
   const learner::StepStats stats = learner.gradients(batch);

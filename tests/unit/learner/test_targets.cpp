@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "learner/targets.hpp"
+#include "../qattention/content_q.hpp"
 #include "../qattention/random_cloud.hpp"
 
 using namespace qte;
@@ -19,33 +20,6 @@ using namespace qte::qattention;
 namespace {
 
 constexpr int V = 16, kCells = V * V * V;
-
-// A Q function of the grid's content alone, irregular enough for no ties; `phase` makes
-// another network of it (online and target disagree everywhere).
-DepthEvaluator content_q(float phase) {
-  return [phase](int depth, const float* grids, const float*, int batch) {
-    nets::QValues out;
-    out.batch = batch;
-    out.translation.resize(static_cast<std::size_t>(batch) * kCells);
-    out.rotation.resize(static_cast<std::size_t>(batch) * 3 * 72);
-    out.gripper.resize(static_cast<std::size_t>(batch) * 2);
-    for (int b = 0; b < batch; ++b) {
-      double sum = 0;
-      for (int cell = 0; cell < kCells; ++cell) {
-        const float* c = grids + (static_cast<std::size_t>(b) * kCells + cell) * voxels::kChannels;
-        out.translation[static_cast<std::size_t>(b) * kCells + cell] =
-            c[9] * std::sin(17 * c[0] + 29 * c[1] + 41 * c[2] + depth + phase) +
-            0.1f * std::cos(13 * c[6] + 7 * c[7] + 5 * c[8] + phase);
-        sum += c[0] + c[1];
-      }
-      for (int i = 0; i < 3 * 72; ++i)
-        out.rotation[static_cast<std::size_t>(b) * 216 + i] = static_cast<float>(std::sin(0.37 * i + sum + phase));
-      out.gripper[b * 2] = static_cast<float>(std::sin(sum + phase));
-      out.gripper[b * 2 + 1] = static_cast<float>(std::cos(sum + 2 * phase));
-    }
-    return out;
-  };
-}
 
 int first_best(const float* q, int count) { return static_cast<int>(std::max_element(q, q + count) - q); }
 
@@ -128,7 +102,7 @@ float bootstrap(const learner::Minibatch& b, int i, float value) {
 // Tree-expanded targets, K = 1 and 3 over 2 depths and K = 3 over 3 depths: indices from the
 // online network, values from the target network, at every depth and in the heads.
 TEST(BootstrapTargets, TreeExpansionRanksWithTheOnlineNetworkAndValuesWithTheTarget) {
-  const DepthEvaluator online = content_q(0.0f), target = content_q(1.3f);
+  const DepthEvaluator online = test_support::content_q(0.0f), target = test_support::content_q(1.3f);
   for (auto [depths, k] : {std::pair{2, 1}, std::pair{2, 3}, std::pair{3, 3}}) {
     SCOPED_TRACE("depths " + std::to_string(depths) + ", K " + std::to_string(k));
     Case c(depths, k);
@@ -154,7 +128,7 @@ TEST(BootstrapTargets, TreeExpansionRanksWithTheOnlineNetworkAndValuesWithTheTar
 
 // K = 0 (C2F-ARM): down the online network's greedy path, each depth's own target Q, no averaging.
 TEST(BootstrapTargets, DoubleDqnValuesEachDepthsGreedyVoxelWithTheTargetNetwork) {
-  const DepthEvaluator online = content_q(0.0f), target = content_q(1.3f);
+  const DepthEvaluator online = test_support::content_q(0.0f), target = test_support::content_q(1.3f);
   Case c(2, 0);
   const learner::Targets t = learner::bootstrap_targets(online, target, c.config, c.batch);
   for (int i = 0; i < c.batch.size; ++i) {
@@ -168,7 +142,7 @@ TEST(BootstrapTargets, DoubleDqnValuesEachDepthsGreedyVoxelWithTheTargetNetwork)
 // --tree-target 1 with one network is the paper's Algorithm 2 with K = 1: the value at depth 0
 // is (q0 + q1) / 2 of the greedy path.
 TEST(BootstrapTargets, TreeTargetOneIsAlgorithmTwoWithKOne) {
-  const DepthEvaluator q = content_q(0.4f);
+  const DepthEvaluator q = test_support::content_q(0.4f);
   Case c(2, 1);
   const learner::Targets t = learner::bootstrap_targets(q, q, c.config, c.batch);
   std::vector<voxels::PointCloud> clouds;

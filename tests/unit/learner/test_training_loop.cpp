@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "common/error.hpp"
 #include "learner/training_loop.hpp"
 #include "learner_fixtures.hpp"
 #include "stream/reader.hpp"
@@ -27,8 +28,12 @@ TEST(Pacing, EachStepNeedsTheFewestAgentTransitionsThatAllowIt) {
         SCOPED_TRACE("ratio " + std::to_string(ratio) + ", pretrain " + std::to_string(pretrain) + ", step " +
                      std::to_string(step) + ": needs " + std::to_string(n));
         EXPECT_GT(learner::allowed_steps(o, n), step);
-        if (n > 0) EXPECT_LE(learner::allowed_steps(o, n - 1), step);
-        if (step < pretrain) EXPECT_EQ(n, 0);
+        if (n > 0) {
+          EXPECT_LE(learner::allowed_steps(o, n - 1), step);
+        }
+        if (step < pretrain) {
+          EXPECT_EQ(n, 0);
+        }
       }
     }
   }
@@ -119,4 +124,30 @@ TEST(TrainingLoop, FollowTakesTheStepsTheReplayRatioAllowsAndStops) {
   EXPECT_EQ(state->scalar<int64_t>("agent_transitions"), 6);
   EXPECT_GT(state->scalar<double>("max_priority"), 0);
   std::filesystem::remove_all(dir);
+}
+
+// Sizes a run cannot hold are refused before anything is allocated (a batch of 100,000 grew
+// to 24 GB until the kernel killed it; a tree target of 100,000 branches ran for minutes).
+TEST(LearnerConfig, StepsThatCannotFitInMemoryAreRefused) {
+  learner::LearnerConfig config;
+  const double machine = 24e9;
+  EXPECT_NO_THROW(config.check_memory(machine));  // the defaults
+  config.tree_target_k = 10;
+  EXPECT_NO_THROW(config.check_memory(machine));  // the published K
+  config.batch = 128;
+  EXPECT_NO_THROW(config.check_memory(machine));  // the published batch
+  config.batch = 100000;
+  EXPECT_THROW(config.check_memory(machine), UsageError);
+  config.batch = 32;
+  config.tree_target_k = 100000;
+  try {
+    config.check_memory(machine);
+    FAIL() << "a 100,000-branch tree target was accepted";
+  } catch (const UsageError& e) {
+    EXPECT_NE(std::string(e.what()).find("GB per step; this machine has 24 GB"), std::string::npos) << e.what();
+  }
+  learner::LearnerConfig arm;
+  arm.net.architecture = nets::Architecture::arm;
+  arm.net.base_channels = 64;
+  EXPECT_GT(arm.step_memory_bytes(), 10 * config.batch * 1e6);
 }

@@ -311,6 +311,26 @@ TEST(Checkpoint, LoadErrorsNameTheField) {
   std::remove(path.c_str());
 }
 
+// A checkpoint's settings are checked before any network is built from them: 2^31 - 1 depths
+// or base channels asked for terabytes.
+TEST(Checkpoint, SettingsOutOfRangeAreRefusedBeforeBuilding) {
+  seed_torch(33);
+  const stream::Record good = checkpoint_record(make_coarse_to_fine_nets(config_of(Architecture::light, 8), 2), nullptr, 0);
+  for (const char* field : {"depths", "base_channels", "voxels", "channels", "proprio"}) {
+    for (int64_t bad : {int64_t{2147483647}, int64_t{1} << 40, int64_t{0}, int64_t{-3}}) {
+      stream::Record hostile = good;
+      hostile.set_scalar<int64_t>(field, bad);
+      try {
+        checkpoint_config(hostile);
+        ADD_FAILURE() << field << " = " << bad << " accepted";
+      } catch (const StreamError& e) {
+        EXPECT_NE(std::string(e.what()).find(std::string("field '") + field + "'"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("got " + std::to_string(bad)), std::string::npos) << e.what();
+      }
+    }
+  }
+}
+
 TEST(Checkpoint, DamagedFileGivesStreamError) {
   const std::string path = temp_path("damaged.rec");
   seed_torch(41);

@@ -9,7 +9,9 @@
 #include <limits>
 #include <random>
 
+#include "common/error.hpp"
 #include "qattention/tree_expansion.hpp"
+#include "content_q.hpp"
 #include "random_cloud.hpp"
 
 using namespace qte;
@@ -183,34 +185,6 @@ Path algorithm2(const DepthEvaluator& evaluate, const voxels::CoarseToFine& hier
     }
   }
   return best;
-}
-
-// A Q function of the grid's content alone (so a grid's Qs do not depend on the batch it is
-// in), irregular enough that top-K and max have no ties: per voxel from its mean point, colour
-// and index; rotation and gripper from the whole grid.
-nets::QValues content_q(int depth, const float* grids, const float*, int batch) {
-  nets::QValues out;
-  out.batch = batch;
-  out.translation.resize(static_cast<std::size_t>(batch) * kCells);
-  out.rotation.resize(static_cast<std::size_t>(batch) * 3 * 72);
-  out.gripper.resize(static_cast<std::size_t>(batch) * 2);
-  for (int b = 0; b < batch; ++b) {
-    double sum_x = 0, occupied = 0;
-    for (int cell = 0; cell < kCells; ++cell) {
-      const float* c = grids + (static_cast<std::size_t>(b) * kCells + cell) * voxels::kChannels;
-      const float point = c[9] * std::sin(17 * c[0] + 29 * c[1] + 41 * c[2] + depth);
-      out.translation[static_cast<std::size_t>(b) * kCells + cell] =
-          point + 0.25f * c[9] * c[3] + 0.1f * std::cos(13 * c[6] + 7 * c[7] + 5 * c[8] + 0.3f * depth);
-      sum_x += c[0];
-      occupied += c[9];
-    }
-    for (int i = 0; i < 3 * 72; ++i)
-      out.rotation[static_cast<std::size_t>(b) * 216 + i] =
-          static_cast<float>(std::sin(0.37 * i * (1 + occupied) + sum_x));
-    out.gripper[b * 2] = static_cast<float>(std::sin(sum_x));
-    out.gripper[b * 2 + 1] = static_cast<float>(std::cos(sum_x));
-  }
-  return out;
 }
 
 // Batched expand and the plain recursion side by side; `exact`: the same floats (a Q function
@@ -387,7 +361,7 @@ TEST(TreeExpansion, ThreeDepthsNestAsAlgorithmTwoByHand) {
 TEST(TreeExpansion, BatchedEqualsAlgorithmTwoOneBranchAtATime) {
   const Cloud cloud;
   for (int depths : {2, 3})
-    for (int k : {1, 2, 5}) expect_same_as_algorithm2(content_q, depths, k, cloud.view(), true);
+    for (int k : {1, 2, 5}) expect_same_as_algorithm2(test_support::content_q(), depths, k, cloud.view(), true);
 }
 
 TEST(TreeExpansion, BatchedEqualsAlgorithmTwoOnRealNetworks) {
@@ -397,5 +371,27 @@ TEST(TreeExpansion, BatchedEqualsAlgorithmTwoOnRealNetworks) {
     nets::seed_torch(5 + depths);
     const auto networks = nets::make_coarse_to_fine_nets(config, depths);
     for (int k : {1, 2, 5}) expect_same_as_algorithm2(network_evaluator(networks), depths, k, cloud.view(), false);
+  }
+}
+
+// A diverged checkpoint gives NaN Q values: an error, never a path read from no branch.
+TEST(TreeExpansion, NonFiniteQValuesAreAnError) {
+  const Cloud cloud;
+  for (int depth : {0, 1}) {
+    for (float bad : {std::nanf(""), std::numeric_limits<float>::infinity()}) {
+      const DepthEvaluator q = [&](int d, const float* grids, const float*, int batch) {
+        nets::QValues out = test_support::content_q_values(d, grids, batch);
+        if (d == depth) out.translation[batch * kCells / 2] = bad;
+        return out;
+      };
+      try {
+        expand(q, voxels::CoarseToFine{}, cloud.view(), {1, 0.04f, 0.04f, 0.5f}, 3);
+        ADD_FAILURE() << "no error for " << bad << " at depth " << depth;
+      } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("depth-" + std::to_string(depth) + " network gave a non-finite Q value"),
+                  std::string::npos)
+            << e.what();
+      }
+    }
   }
 }

@@ -125,3 +125,20 @@ TEST(CurvePlot, PngOfTheAskedSizeAndTheSameBytesEveryTime) {
   EXPECT_EQ(big_endian(20), 300u);
   EXPECT_EQ(curve_plot_png(builder.curves(), options), png);
 }
+
+// Values at the ends of the double range: an error, not a plot whose ticks never end.
+TEST(CurvePlot, ARangeBeyondWhatADoubleHoldsIsAnError) {
+  for (const char* table : {"step,success_rate\n-1e308,0.5\n1e308,0.5\n", "step,success_rate\n0,-1e308\n1,1e308\n"}) {
+    CurveBuilder builder({"step", "success_rate", ""}, Band::std_dev);
+    builder.add(parse_csv("huge.csv", table));
+    CurvePlotOptions options;
+    options.width_px = 200;
+    options.height_px = 150;
+    try {
+      curve_plot_png(builder.curves(), options);
+      ADD_FAILURE() << "plotted " << table;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("more than a plot can draw"), std::string::npos) << e.what();
+    }
+  }
+}

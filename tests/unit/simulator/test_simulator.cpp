@@ -1,6 +1,7 @@
 // The sim-step loop: resets, trajectories, failures, determinism and the tasks' experts.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <set>
 
 #include "common/random.hpp"
@@ -127,6 +128,17 @@ TEST(Simulator, BadTrajectoriesFailTheActionWithAReason) {
               q[3] = 0.2;
               return test_support::straight_trajectory(robot, w.joint_positions(), q, true);
             }).find("-table"), std::string::npos);
+  // Valid but endless: a trajectory longer than a next-best pose may take fails at once
+  // (it used to run for minutes, and from ~1e8 s overflowed the control-step count).
+  for (double end_s : {1e5, 1e9, 1e300}) {
+    const auto started = std::chrono::steady_clock::now();
+    EXPECT_EQ(failure_of([&](const sim::World& w) {
+                stream::Record t = test_support::straight_trajectory(robot, w.joint_positions(), w.joint_positions(), true);
+                t.set<double>("time_s", {2}, std::vector<double>{0, end_s});
+                return t;
+              }).rfind("invalid_trajectory:longer than", 0), 0u) << end_s;
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count(), 10.0);
+  }
   // A planner failure passed on.
   EXPECT_EQ(failure_of([](const sim::World&) {
               stream::Record t("trajectory");

@@ -6,6 +6,14 @@
 
 #include "stream/codec.hpp"
 #include "stream/reader.hpp"
+#include "stream/writer.hpp"
+
+#include <signal.h>
+#include <stdlib.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 using namespace qte;
 using namespace qte::stream;
@@ -226,4 +234,49 @@ TEST(Damage, EveryTruncationIsAnErrorNotACrash) {
     std::vector<uint8_t> cut(bytes.begin(), bytes.begin() + n);
     EXPECT_NE(read_error(cut), "") << n;
   }
+}
+
+// A failed append (here a file-size limit standing in for a full disk) leaves the file as it
+// was: the next append lands behind the last whole record and every record reads back.
+TEST(Append, AFailedAppendLeavesNoTornRecord) {
+  char tmpl[] = "/tmp/qte_append_XXXXXX";
+  const std::string path = std::string(::mkdtemp(tmpl)) + "/replay.rec";
+  {
+    RecordWriter w(path, {WriteMode::append});
+    w.write(sample_record());
+    w.close();
+  }
+  struct stat before {};
+  ASSERT_EQ(::stat(path.c_str(), &before), 0);
+  const pid_t child = ::fork();
+  if (child == 0) {  // a writer whose disk fills up half-way through a large record
+    ::signal(SIGXFSZ, SIG_IGN);
+    const rlimit limit{static_cast<rlim_t>(before.st_size + 100), static_cast<rlim_t>(before.st_size + 100)};
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+    Record big("transition");
+    big.set<float>("payload", {100000}, std::vector<float>(100000, 1.5f));
+    try {
+      RecordWriter w(path, {WriteMode::append});
+      w.write(big);
+      ::_exit(0);  // should not get here
+    } catch (const Error&) {
+      ::_exit(3);
+    }
+  }
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 3) << "the append did not fail";
+  struct stat after {};
+  ASSERT_EQ(::stat(path.c_str(), &after), 0);
+  EXPECT_EQ(after.st_size, before.st_size) << "a torn record was left behind";
+  {
+    RecordWriter w(path, {WriteMode::append});
+    w.write(sample_record());
+    w.close();
+  }
+  RecordReader reader(path);
+  int records = 0;
+  while (reader.next()) ++records;
+  EXPECT_EQ(records, 2);
 }
