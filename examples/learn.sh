@@ -50,7 +50,7 @@ while [ ! -f "$run/ckpt/latest.rec" ]; do kill -0 $learner || { tail -2 "$run/tr
 learner_step() { ls "$run/ckpt" | sed -n 's/^step-0*\([0-9][0-9]*\)\.rec$/\1/p' | sort -n | tail -1; }
 # Waits until the learner has taken the steps the replay ratio allows for `agent` transitions.
 wait_for_learner() {
-  local want=$(( PRETRAIN + $(awk -v r="$RATIO" -v n="$1" 'BEGIN { printf "%d", r * n }') ))
+  local want; want=$(qattn-train --steps-allowed "$1" --pretrain "$PRETRAIN" --replay-ratio "$RATIO")
   want=$(( want / CHECKPOINT_EVERY * CHECKPOINT_EVERY ))
   while [ "$(learner_step)" -lt "$want" ]; do kill -0 $learner || { tail -2 "$run/train.log"; exit 1; }; sleep 1; done
 }

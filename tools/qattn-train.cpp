@@ -65,7 +65,7 @@ static cli::Usage usage() {
       "64 base channels, 0.88 M / 1.19 M parameters, 1.8 GMAC per sample: 20 times the work "
       "per step on a CPU).",
   };
-  u.arguments = {{"FILE", "frame and transition records; '-' is standard input", false, true}};
+  u.arguments = {{"FILE", "frame and transition records; '-' is standard input (at least one)", true, true}};
   u.options = {
       {"checkpoint-dir", "DIR", "where checkpoints go (required)", ""},
       {"steps", "N", "gradient steps to reach (0: write the initial networks and exit)", "1000"},
@@ -73,6 +73,8 @@ static cli::Usage usage() {
       {"follow", "", "keep reading the inputs as they grow; pace training by --replay-ratio", ""},
       {"stop-file", "FILE", "with --follow: finish once FILE exists and the allowed steps are done", ""},
       {"replay-ratio", "R", "with --follow: gradient steps per agent transition", "1"},
+      {"steps-allowed", "N", "print the gradient steps --follow allows after N agent transitions (with --pretrain and "
+                             "--replay-ratio) and exit: the pacing rule, for scripts that wait on the learner", ""},
       {"pretrain", "N", "with --follow: steps allowed before any agent transition, on the demonstrations even below --start-after", "0"},
       {"start-after", "N", "train once the replay holds N transitions (demos included)", "200"},
       {"checkpoint-every", "N", "steps between checkpoints", "100"},
@@ -137,7 +139,6 @@ static void run(const cli::Arguments& args) {
   config.n_step = static_cast<int>(args.integer("n-step", 1, 10));
   config.validate();
   config.check_memory(static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE)));
-  if (!args.has("checkpoint-dir")) throw UsageError("--checkpoint-dir is required");
 
   learner::LoopOptions loop;
   loop.steps = args.integer("steps", 0, 1000000000000);
@@ -152,7 +153,12 @@ static void run(const cli::Arguments& args) {
   loop.metrics_path = args.text("metrics");
   loop.seed = args.seed();
   loop.threads = static_cast<int>(args.integer("threads", 1, 256));
-  if (loop.threads < 1 || loop.threads > 256) throw UsageError("--threads must be 1-256");
+  if (args.has("steps-allowed")) {
+    std::cout << learner::allowed_steps(loop, args.integer("steps-allowed", 0, INT64_MAX)) << "\n";
+    return;
+  }
+  if (!args.has("checkpoint-dir")) throw UsageError("--checkpoint-dir is required");
+  if (args.positional().empty()) throw UsageError("missing argument FILE");
   replay::ReplayOptions replay_options;
   replay_options.capacity = static_cast<std::size_t>(std::max<int64_t>(1, args.integer("capacity", 1, 1000000000)));
   replay_options.prioritised = !args.flag("uniform");

@@ -8,6 +8,9 @@ demo-record --task lift_numbered_block --episodes 2 --seed 3 --image-size 48x48 
 keyframe --seed 1 --output "$tmp/tr.rec" "$tmp/demos.rec" 2>/dev/null || fail "keyframe"
 train() { qattn-train --batch 4 --start-after 4 --seed 5 --log-every 2 "$@"; }
 
+# The pacing rule, for scripts that wait on the learner (learn.sh): pretrain + floor(ratio * n).
+[ "$(qattn-train --steps-allowed 7 --pretrain 3 --replay-ratio 0.5)" = 6 ] || fail "--steps-allowed"
+
 # --steps 0: the initial networks, at once, for an actor to start with.
 train --steps 0 --checkpoint-dir "$tmp/init" "$tmp/tr.rec" 2>/dev/null || fail "--steps 0"
 [ -f "$tmp/init/step-00000000.rec" ] && [ -f "$tmp/init/latest.rec" ] || fail "no initial checkpoint"
