@@ -55,7 +55,7 @@ static void run(const cli::Arguments& args) {
   options.episodes.seed = args.seed();
   options.episodes.scenes = simulator::scene_set_from_name(args.text("scenes"));
   options.retries = static_cast<int>(args.integer("retries", 0, 1000));
-  options.planner.time_budget_s = args.real("time-budget");
+  options.planner.time_budget_s = args.real("time-budget", 0.001, 600);
   options.planner.seed = args.seed();
   options.simulator = simulator::options_from_camera_arguments(args.text("cameras"), args.text("image-size"));
   options.simulator.point_clouds = true;  // the planner needs them; dropped on output with --no-points

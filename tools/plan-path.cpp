@@ -52,11 +52,11 @@ static cli::Usage usage() {
 
 static void run(const cli::Arguments& args) {
   planning::PlannerOptions options;
-  options.time_budget_s = args.real("time-budget");
-  options.velocity_scale = args.real("velocity-scale");
-  options.max_acceleration_rad_s2 = args.real("acceleration");
-  options.clearance_m = args.real("clearance");
-  options.scene.resolution_m = args.real("resolution");
+  options.time_budget_s = args.real("time-budget", 0.001, 600);
+  options.velocity_scale = args.real("velocity-scale", 0.01, 1);
+  options.max_acceleration_rad_s2 = args.real("acceleration", 0.1, 1000);
+  options.clearance_m = args.real("clearance", 0, 0.5);
+  options.scene.resolution_m = args.real("resolution", 0.002, 0.1);
   options.seed = args.seed();
   if (!(options.time_budget_s > 0) || !(options.velocity_scale > 0 && options.velocity_scale <= 1) ||
       !(options.max_acceleration_rad_s2 > 0) || !(options.scene.resolution_m >= 0.002))

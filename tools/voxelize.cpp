@@ -1,6 +1,7 @@
 // voxelize: observations to coarse-to-fine voxel grids (C2F-ARM's 10 channels).
 #include <sys/stat.h>
 
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -63,9 +64,9 @@ static std::vector<double> numbers(const std::string& option, const std::string&
     try {
       std::size_t used = 0;
       v.push_back(std::stod(item, &used));
-      if (used != item.size()) throw std::invalid_argument(item);
+      if (used != item.size() || !std::isfinite(v.back())) throw std::invalid_argument(item);
     } catch (const std::exception&) {
-      throw UsageError("--" + option + ": '" + item + "' is not a number");
+      throw UsageError("--" + option + ": '" + item + "' is not a finite number");
     }
   }
   if (v.size() != count) throw UsageError("--" + option + ": expected " + std::to_string(count) + " comma-separated numbers");
@@ -75,7 +76,7 @@ static std::vector<double> numbers(const std::string& option, const std::string&
 static void run(const cli::Arguments& args) {
   const voxels::GridBounds scene = voxels::GridBounds::parse(args.text("bounds"), static_cast<int>(args.integer("voxels", 2, 256)));
   if (scene.voxels > 256) throw UsageError("--voxels must be 2-256");
-  const double offset = args.real("offset");
+  const double offset = args.real("offset", 0.001, 10);
   std::vector<voxels::GridBounds> crops;
   for (const auto& c : args.all("centre")) {
     const auto p = numbers("centre", c, 3);

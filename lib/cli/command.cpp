@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -147,6 +148,16 @@ double Arguments::real(const std::string& name) const {
   } catch (const std::exception&) {
   }
   throw UsageError("--" + name + ": expected a number, got '" + v + "'");
+}
+
+double Arguments::real(const std::string& name, double lo, double hi) const {
+  const double x = real(name);
+  if (!std::isfinite(x) || x < lo || x > hi) {
+    std::ostringstream range;
+    range << lo << ".." << hi;
+    throw UsageError("--" + name + " must be " + range.str() + ", got " + text(name));
+  }
+  return x;
 }
 
 std::vector<std::string> Arguments::all(const std::string& name) const {

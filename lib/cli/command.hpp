@@ -53,6 +53,8 @@ class Arguments {
   // The same, refused with a UsageError outside lo..hi (no value wraps when a tool narrows it).
   int64_t integer(const std::string& name, int64_t lo, int64_t hi) const;
   double real(const std::string& name) const;
+  // The same, refused with a UsageError unless finite and within lo..hi.
+  double real(const std::string& name, double lo, double hi) const;
   std::vector<std::string> all(const std::string& name) const;  // repeatable options
   const std::vector<std::string>& positional() const { return positional_; }
   uint64_t seed() const { return static_cast<uint64_t>(integer("seed")); }

@@ -119,7 +119,13 @@ void Simulator::handle(const stream::Record& record,
 void Simulator::reset(const stream::Record& record,
                       const std::function<void(const stream::Record&)>& emit) {
   task_name_ = record.string("task");
-  task_ = tasks::make_task(task_name_);
+  try {
+    task_ = tasks::make_task(task_name_);
+  } catch (const StreamError&) {
+    throw;
+  } catch (const Error& e) {
+    record.fail("task", std::string("a known task: ") + e.what());
+  }
   variation_ = record.has("variation") ? record.scalar<int32_t>("variation") : 0;
   if (variation_ < 0 || variation_ >= task_->variation_count())
     record.fail("variation", "0 to " + std::to_string(task_->variation_count() - 1) + " for " +

@@ -31,6 +31,16 @@ for case in nan:invalid_pose nonunit:invalid_pose far:outside_workspace; do
 done
 
 # An action with no observation before it is a stream error naming the record.
+# Settings outside what a plan can use are usage errors, not minutes of planning or a silent
+# negative clearance.
+for bad in "--time-budget inf" "--velocity-scale 1e-300" "--clearance -1" "--acceleration 1e-12" "--time-budget nan"; do
+  err=$(plan-path $bad < "$tmp/action.rec" 2>&1 >/dev/null); rc=$?
+  [ $rc = 2 ] && grep -q -- "${bad%% *} must be" <<<"$err" || fail "plan-path $bad: exit $rc: $err"
+done
+err=$(voxelize --offset -1 < "$tmp/action.rec" 2>&1 >/dev/null); rc=$?
+[ $rc = 2 ] && grep -q -- "--offset must be" <<<"$err" || fail "voxelize --offset -1: exit $rc: $err"
+err=$(voxelize --centre 0.1,nan,0.9 < "$tmp/action.rec" 2>&1 >/dev/null); rc=$?
+[ $rc = 2 ] && grep -q -- "'nan' is not a finite number" <<<"$err" || fail "voxelize --centre nan: exit $rc: $err"
 err=$(plan-path < "$tmp/action.rec" 2>&1 >/dev/null); rc=$?
 [ $rc = 1 ] || fail "action before obs: exit $rc"
 grep -q "<stdin>: record 0 at byte 0: action before any observation" <<<"$err" || fail "$err"

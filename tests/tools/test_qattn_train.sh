@@ -87,8 +87,10 @@ stream-cat "$tmp/agent3.rec" | stream-cat --append --output "$tmp/live.rec"
 touch "$tmp/stop-live"
 wait $pid || fail "resumed follow run: $(tail -3 "$tmp/fl2.log")"
 grep -q "resumed at step [1-9]" "$tmp/fl2.log" || fail "did not resume: $(cat "$tmp/fl2.log")"
+state() { stream-dump --type learner "$1" | grep -E "^  (step|transitions_read|agent_transitions|max_priority) " | tr -s ' ' | tr '\n' ';'; }
 cmp -s "$tmp/fa/latest.rec" "$tmp/fl/latest.rec" \
-  || fail "a killed and resumed --follow run differs from one that had every chunk ($(ls "$tmp/fa" | tr '\n' ' ') vs $(ls "$tmp/fl" | tr '\n' ' '))"
+  || fail "a killed and resumed --follow run differs from one that had every chunk: $(state "$tmp/fa/latest.rec") vs" \
+          "$(state "$tmp/fl/latest.rec"); $(grep resumed "$tmp/fl2.log"); $(cmp "$tmp/fa/latest.rec" "$tmp/fl/latest.rec")"
 
 # Bad input: other settings, another grid, non-finite loss, missing file, too few transitions.
 err=$(train --steps 6 --architecture arm --base-channels 8 --checkpoint-dir "$tmp/a" --resume "$tmp/tr.rec" 2>&1) \

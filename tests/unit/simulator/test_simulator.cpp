@@ -90,6 +90,7 @@ TEST(Simulator, UnknownTaskIsAnErrorListingTheTasks) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("known tasks: reach_target, pick_and_lift, lift_numbered_block"),
               std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("'reset' record, field 'task'"), std::string::npos) << e.what();
   }
 }
 
