@@ -19,6 +19,10 @@ uint64_t fnv1a(const void* data, std::size_t n, uint64_t h = 1469598103934665603
 Eigen::Isometry3d gripper_pose(const stream::Record& obs) {
   const auto p = obs.array<double>("gripper_pose");
   if (p.size() != 7) obs.fail("gripper_pose", "float64 [7]");
+  const double norm = std::sqrt(p[3] * p[3] + p[4] * p[4] + p[5] * p[5] + p[6] * p[6]);
+  for (int i = 0; i < 7; ++i)
+    if (!std::isfinite(p[i])) obs.fail("gripper_pose", "finite position and quaternion");
+  if (!(norm > 0.5 && norm < 1.5)) obs.fail("gripper_pose", "a unit quaternion (x, y, z, w), got norm " + std::to_string(norm));
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.translation() << p[0], p[1], p[2];
   pose.linear() = Eigen::Quaterniond(p[6], p[3], p[4], p[5]).normalized().toRotationMatrix();

@@ -32,7 +32,9 @@ void EpisodeSplitter::handle(const stream::Record& obs) {
     return_so_far_ = 0;
   }
   ++observations_;
-  return_so_far_ += obs.scalar<float>("reward");
+  const float reward = obs.scalar<float>("reward");
+  if (!std::isfinite(reward)) obs.fail("reward", "a finite reward");
+  return_so_far_ += reward;
   if (obs.scalar<uint8_t>("terminal") == 0) return;
   Episode e;
   e.seed = obs.has("episode_seed") ? obs.scalar<int64_t>("episode_seed") : 0;

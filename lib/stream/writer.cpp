@@ -11,6 +11,7 @@ namespace qte::stream {
 
 RecordWriter::RecordWriter(const std::string& path, WriteOptions options)
     : path_(path), options_(options) {
+  if (path.empty()) throw UsageError("an empty output path: name a file, or '-' for standard output");
   if (path == "-") {
     if (::isatty(1))
       throw Error("refusing to write a binary stream to a terminal: redirect stdout to a file "

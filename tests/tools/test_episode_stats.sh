@@ -98,4 +98,11 @@ err=$(episode-stats "$tmp/flipped.rec" 2>&1 >/dev/null); rc=$?
 err=$(stream-pack obs terminal:u8=1 success:u8=0 step:i32=0 | episode-stats 2>&1 >/dev/null); rc=$?
 [ $rc = 1 ] && grep -q "<stdin>: record 0 at byte 0: 'obs' record has no field 'reward'" <<<"$err" \
   || fail "missing field: $rc $err"
+# A NaN reward is an error naming the record, not a 'nan' return in the table.
+err=$(obs 0 0 1 0 nan 4 | episode-stats 2>&1 >/dev/null); rc=$?
+[ $rc = 1 ] && grep -q "<stdin>: record 0 at byte 0: 'obs' record, field 'reward': expected a finite reward" <<<"$err" \
+  || fail "NaN reward: $rc $err"
+# No file named '' is attempted.
+err=$(obs 0 0 1 0 0 4 | stream-cat --output "" 2>&1); rc=$?
+[ $rc = 2 ] && grep -q "an empty output path" <<<"$err" || fail "--output '': $rc $err"
 echo "episode-stats ok"

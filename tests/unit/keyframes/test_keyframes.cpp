@@ -2,9 +2,11 @@
 // transitions' crop augmentation.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 #include <set>
 
+#include "common/error.hpp"
 #include "demos/demo_recorder.hpp"
 #include "keyframes/keyframes.hpp"
 #include "keyframes/transitions.hpp"
@@ -236,4 +238,32 @@ TEST(Transitions, BadEpisodesAreSkippedAndCounted) {
   // The good one: keyframes at the gripper change (6) and the last frame (11); one chain from
   // frame 0 and one from frame 10 (demo augmentation): 2 + 1 transitions.
   EXPECT_EQ(c.transitions, 3);
+}
+
+// A zero or NaN quaternion in a demonstration is refused naming the record, not binned as
+// some rotation.
+TEST(Transitions, AGripperPoseWithoutARotationIsRefused) {
+  const robot::RobotModel robot = robot::RobotModel::xarm7();
+  demos::DemoOptions options;
+  options.episodes = {"reach_target", 0, 1, 4};
+  options.simulator.cameras[0].intrinsics.width = options.simulator.cameras[0].intrinsics.height = 16;
+  std::vector<stream::Record> demo;
+  demos::record_demos(robot, options, [&](const stream::Record& r) { demo.push_back(r); }, [](const std::string&) {});
+  for (const std::vector<double>& quaternion : {std::vector<double>{0, 0, 0, 0}, std::vector<double>{NAN, 0, 0, 1}}) {
+    std::vector<stream::Record> damaged = demo;
+    for (auto& r : damaged)
+      if (r.type() == "obs") {
+        const auto p = r.array<double>("gripper_pose");
+        r.set<double>("gripper_pose", {7}, std::vector<double>{p[0], p[1], p[2], quaternion[0], quaternion[1],
+                                                               quaternion[2], quaternion[3]});
+      }
+    EpisodeConverter converter(TransitionOptions{}, [](const stream::Record&) {});
+    try {
+      for (const auto& r : damaged) converter.handle(r);
+      converter.finish();
+      ADD_FAILURE() << "converted an episode without rotations";
+    } catch (const StreamError& e) {
+      EXPECT_NE(std::string(e.what()).find("field 'gripper_pose'"), std::string::npos) << e.what();
+    }
+  }
 }
