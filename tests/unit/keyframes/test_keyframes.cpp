@@ -147,15 +147,26 @@ TEST_P(ExpertKeyframes, MatchTheExpertsWaypoints) {
 
 INSTANTIATE_TEST_SUITE_P(Tasks, ExpertKeyframes, ::testing::Values("reach_target", "pick_and_lift", "lift_numbered_block"));
 
-TEST(Transitions, ChainsRewardsAndReferencesToStoredFrames) {
-  const robot::RobotModel robot = robot::RobotModel::xarm7();
+namespace {
+
+// One expert demonstration of `task` (seed 4), every record, at `pixels` square.
+std::vector<stream::Record> one_demonstration(const std::string& task, int pixels) {
   demos::DemoOptions options;
-  options.episodes = {"pick_and_lift", 0, 1, 4};
-  options.simulator.cameras[0].intrinsics.width = options.simulator.cameras[0].intrinsics.height = 32;
+  options.episodes = {task, 0, 1, 4};
+  options.simulator.cameras[0].intrinsics.width = options.simulator.cameras[0].intrinsics.height = pixels;
+  std::vector<stream::Record> records;
+  demos::record_demos(robot::RobotModel::xarm7(), options, [&](const stream::Record& r) { records.push_back(r); },
+                      [](const std::string&) {});
+  return records;
+}
+
+}  // namespace
+
+TEST(Transitions, ChainsRewardsAndReferencesToStoredFrames) {
   std::vector<stream::Record> out;
   TransitionOptions transition_options;
   EpisodeConverter converter(transition_options, [&](const stream::Record& r) { out.push_back(r); });
-  demos::record_demos(robot, options, [&](const stream::Record& r) { converter.handle(r); }, [](const std::string&) {});
+  for (const auto& r : one_demonstration("pick_and_lift", 32)) converter.handle(r);
   converter.finish();
   ASSERT_EQ(converter.counts().converted, 1);
   std::set<int> frames;
@@ -243,12 +254,7 @@ TEST(Transitions, BadEpisodesAreSkippedAndCounted) {
 // A zero or NaN quaternion in a demonstration is refused naming the record, not binned as
 // some rotation.
 TEST(Transitions, AGripperPoseWithoutARotationIsRefused) {
-  const robot::RobotModel robot = robot::RobotModel::xarm7();
-  demos::DemoOptions options;
-  options.episodes = {"reach_target", 0, 1, 4};
-  options.simulator.cameras[0].intrinsics.width = options.simulator.cameras[0].intrinsics.height = 16;
-  std::vector<stream::Record> demo;
-  demos::record_demos(robot, options, [&](const stream::Record& r) { demo.push_back(r); }, [](const std::string&) {});
+  const std::vector<stream::Record> demo = one_demonstration("reach_target", 16);
   for (const std::vector<double>& quaternion : {std::vector<double>{0, 0, 0, 0}, std::vector<double>{NAN, 0, 0, 1}}) {
     std::vector<stream::Record> damaged = demo;
     for (auto& r : damaged)
