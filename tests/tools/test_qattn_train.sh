@@ -6,7 +6,10 @@ source "$(dirname "$0")/common.sh"
 demo-record --task lift_numbered_block --episodes 2 --seed 3 --image-size 48x48 --output "$tmp/demos.rec" 2>/dev/null \
   || fail "demo-record"
 keyframe --seed 1 --output "$tmp/tr.rec" "$tmp/demos.rec" 2>/dev/null || fail "keyframe"
-train() { qattn-train --batch 4 --start-after 4 --seed 5 --log-every 2 "$@"; }
+# Options as arrays: a program started in the background must be the process $! names (a
+# shell function would run it under a subshell, and kill -9 of that would leave it running).
+train_options=(--batch 4 --start-after 4 --seed 5 --log-every 2)
+train() { qattn-train "${train_options[@]}" "$@"; }
 
 # The pacing rule, for scripts that wait on the learner (learn.sh): pretrain + floor(ratio * n).
 [ "$(qattn-train --steps-allowed 7 --pretrain 3 --replay-ratio 0.5)" = 6 ] || fail "--steps-allowed"
@@ -42,10 +45,12 @@ err=$(train --steps 6 --checkpoint-every 3 --checkpoint-dir "$tmp/b" --resume --
 grep -q "started with --threads 2; resume it with the same, not 1" <<<"$err" || fail "$err"
 
 # Killed mid-run: the last checkpoint is whole and the run resumes from it.
-train --steps 1000 --checkpoint-every 2 --checkpoint-dir "$tmp/k" "$tmp/tr.rec" 2>/dev/null &
+qattn-train "${train_options[@]}" --steps 1000 --checkpoint-every 2 --checkpoint-dir "$tmp/k" "$tmp/tr.rec" 2>/dev/null &
 pid=$!
-for _ in $(seq 600); do [ -f "$tmp/k/step-00000004.rec" ] && break; sleep 0.1; done
+# (any checkpoint from step 4 on: --keep removes the older ones)
+for _ in $(seq 600); do ls "$tmp/k" 2>/dev/null | grep -qE "^step-0+([4-9]|[1-9][0-9]+)\.rec$" && break; sleep 0.1; done
 kill -9 $pid; wait $pid 2>/dev/null
+kill -0 $pid 2>/dev/null && fail "the learner survived kill -9"
 stream-dump --summary "$tmp/k/latest.rec" > /dev/null || fail "the checkpoint after a kill is damaged"
 ls -a "$tmp/k" | grep -q tmp && fail "temporary files left: $(ls -a "$tmp/k")"
 train --steps 5 --checkpoint-dir "$tmp/k" --resume "$tmp/tr.rec" 2> "$tmp/k.log" || fail "resume after kill: $(cat "$tmp/k.log")"
@@ -67,20 +72,22 @@ wait $pid || fail "follow run: $(cat "$tmp/f.log")"
 # the actor goes on appending, ends with the bytes of a run that found every chunk there
 # from the start (each step learns from the agent transitions the replay ratio needs for it).
 for c in 1 2 3; do keyframe --not-demo --seed 1$c --output "$tmp/agent$c.rec" "$tmp/demos.rec" 2>/dev/null || fail "agent $c"; done
-follow() { qattn-train --follow --pretrain 2 --replay-ratio 0.5 --start-after 1 --batch 2 --steps 1000 --seed 7 \
-  --checkpoint-every 2 "$@"; }
+follow_options=(--follow --pretrain 2 --replay-ratio 0.5 --start-after 1 --batch 2 --steps 1000 --seed 7
+                --checkpoint-every 2)
 cat "$tmp/tr.rec" "$tmp/agent1.rec" "$tmp/agent2.rec" "$tmp/agent3.rec" > "$tmp/all.rec"
 touch "$tmp/stop-all"
-follow --stop-file "$tmp/stop-all" --checkpoint-dir "$tmp/fa" "$tmp/all.rec" 2> "$tmp/fa.log" \
+qattn-train "${follow_options[@]}" --stop-file "$tmp/stop-all" --checkpoint-dir "$tmp/fa" "$tmp/all.rec" 2> "$tmp/fa.log" \
   || fail "follow, all at once: $(tail -3 "$tmp/fa.log")"
 cp "$tmp/tr.rec" "$tmp/live.rec"
-follow --stop-file "$tmp/stop-live" --checkpoint-dir "$tmp/fl" "$tmp/live.rec" 2> "$tmp/fl.log" &
+qattn-train "${follow_options[@]}" --stop-file "$tmp/stop-live" --checkpoint-dir "$tmp/fl" "$tmp/live.rec" 2> "$tmp/fl.log" &
 pid=$!
 stream-cat "$tmp/agent1.rec" | stream-cat --append --output "$tmp/live.rec"
-for _ in $(seq 600); do [ -f "$tmp/fl/step-00000004.rec" ] && break; sleep 0.1; done
+for _ in $(seq 600); do ls "$tmp/fl" 2>/dev/null | grep -qE "^step-0+([4-9]|[1-9][0-9]+)\.rec$" && break; sleep 0.1; done
 kill -9 $pid; wait $pid 2>/dev/null
+kill -0 $pid 2>/dev/null && fail "the learner survived kill -9"
 stream-cat "$tmp/agent2.rec" | stream-cat --append --output "$tmp/live.rec"
-follow --resume --stop-file "$tmp/stop-live" --checkpoint-dir "$tmp/fl" "$tmp/live.rec" 2> "$tmp/fl2.log" &
+qattn-train "${follow_options[@]}" --resume --stop-file "$tmp/stop-live" --checkpoint-dir "$tmp/fl" "$tmp/live.rec" \
+  2> "$tmp/fl2.log" &
 pid=$!
 sleep 1
 stream-cat "$tmp/agent3.rec" | stream-cat --append --output "$tmp/live.rec"
