@@ -35,7 +35,7 @@ static cli::Usage usage() {
       "target update after every step. Priorities are the mean over depths of the absolute "
       "TD error.",
       "Every default is the published value except the batch (32, published 128: a quarter of "
-      "the time per step on a CPU) and the network (light, published arm: a tenth of the cost "
+      "the time per step on a CPU) and the network (light, published arm: a twentieth of the cost "
       "per step); priorities count each depth once (the public code counts depth 0 twice). "
       "The README's table of settings gives each with its reason.",
       "Checkpoints go to DIR/step-NNNNNNNN.rec every --checkpoint-every steps (the last --keep "

@@ -8,6 +8,7 @@
 #include "cli/command.hpp"
 #include "stream/reader.hpp"
 #include "stream/writer.hpp"
+#include "voxels/grid_fields.hpp"
 #include "voxels/observation_cloud.hpp"
 #include "voxels/occupancy_channels.hpp"
 #include "voxels/voxel_image.hpp"
@@ -109,13 +110,15 @@ static void run(const cli::Arguments& args) {
     const int64_t channels = voxels::kChannels + (space ? voxels::kOccupancyChannels : 0);
     stream::Record out("voxels");
     out.set<float>("depth0.grid", {v, v, v, channels}, with_channels(grid.data(), scene));
-    out.set<double>("depth0.bounds", {4}, std::vector<double>{scene.min_corner.x(), scene.min_corner.y(),
-                                                              scene.min_corner.z(), scene.size_m});
+    out.set<double>("depth0.bounds", {4}, voxels::bounds_values(scene));
     if (!crops.empty()) {
       voxels::voxelize_many(cloud.view(), crops, crop_grids.data());
       const int64_t k = static_cast<int64_t>(crops.size());
       std::vector<double> bounds;
-      for (const auto& c : crops) bounds.insert(bounds.end(), {c.min_corner.x(), c.min_corner.y(), c.min_corner.z(), c.size_m});
+      for (const auto& c : crops) {
+        const std::vector<double> b = voxels::bounds_values(c);
+        bounds.insert(bounds.end(), b.begin(), b.end());
+      }
       std::vector<float> all;
       for (std::size_t c = 0; c < crops.size(); ++c) {
         const auto one = with_channels(crop_grids.data() + c * grid_floats, crops[c]);

@@ -5,6 +5,7 @@
 
 #include "common/random.hpp"
 #include "keyframes/keyframes.hpp"
+#include "voxels/grid_fields.hpp"
 
 namespace qte::keyframes {
 namespace {
@@ -249,8 +250,7 @@ void EpisodeConverter::convert(std::vector<stream::Record>& episode, const strea
         const voxels::GridBounds b = h.bounds_at(d, centre);
         const std::string prefix = "depth" + std::to_string(d);
         t.set<int32_t>(prefix + ".index", {3}, indices[d].data());
-        t.set<double>(prefix + ".bounds", {4},
-                      std::vector<double>{b.min_corner.x(), b.min_corner.y(), b.min_corner.z(), b.size_m});
+        t.set<double>(prefix + ".bounds", {4}, voxels::bounds_values(b));
         centre = b.centre_of(indices[d]);
       }
       const Eigen::Vector3i bins = rotation_bins(pose.linear());

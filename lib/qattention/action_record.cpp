@@ -5,16 +5,9 @@
 #include <vector>
 
 #include "keyframes/keyframes.hpp"
+#include "voxels/grid_fields.hpp"
 
 namespace qte::qattention {
-
-namespace {
-
-std::vector<double> bounds_field(const voxels::GridBounds& b) {
-  return {b.min_corner.x(), b.min_corner.y(), b.min_corner.z(), b.size_m};
-}
-
-}  // namespace
 
 stream::Record action_record(const Choice& choice, bool ignore_collisions, int k, bool explored,
                              int64_t checkpoint_step, int32_t step) {
@@ -29,7 +22,7 @@ stream::Record action_record(const Choice& choice, bool ignore_collisions, int k
   for (std::size_t d = 0; d < c.indices.size(); ++d) {
     const std::string prefix = "depth" + std::to_string(d);
     a.set<int32_t>(prefix + ".index", {3}, c.indices[d].data());
-    a.set<double>(prefix + ".bounds", {4}, bounds_field(c.bounds[d]));
+    a.set<double>(prefix + ".bounds", {4}, voxels::bounds_values(c.bounds[d]));
     const Eigen::Vector3d centre = c.bounds[d].centre_of(c.indices[d]);
     a.set<double>(prefix + ".centre", {3}, centre.data());
     a.set_scalar<float>(prefix + ".q_value", c.q_values[d]);
