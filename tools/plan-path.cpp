@@ -20,8 +20,9 @@ static cli::Usage usage() {
       "start_in_collision, goal_in_collision, no_path or timeout.",
       "The scene is an OctoMap built from the last observation's point clouds (every camera's "
       "<camera>.points, inserted as rays from the camera so free space is known; unknown space "
-      "counts as free), with the robot's own links and a held object filtered out, and a "
-      "Euclidean distance field over it. The robot is a set of spheres checked against that "
+      "counts as free), with the robot's own links and a held object filtered out, and an exact "
+      "Euclidean distance field over its occupied voxels; those follow from the rays' endpoints, "
+      "so the rays are traced only for --octomap. The robot is a set of spheres checked against that "
       "field and against itself. Inverse kinematics is damped least squares with joint limits "
       "and seeded restarts, taking the collision-free solution nearest the current joints "
       "(accuracy 0.5 mm, 0.23 degrees). The direct joint-space line is tried first, then "

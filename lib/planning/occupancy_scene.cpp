@@ -1,6 +1,5 @@
 #include "planning/occupancy_scene.hpp"
 
-#include <dynamicEDT3D/dynamicEDTOctomap.h>
 #include <octomap/OcTree.h>
 
 #include <algorithm>
@@ -10,15 +9,30 @@
 
 #include "common/atomic_file.hpp"
 #include "common/error.hpp"
+#include "planning/distance_transform.hpp"
 
 namespace qte::planning {
 
+// Cameras up to which the endpoints alone give the map's occupied voxels (see occupied_keys).
+constexpr std::size_t kCamerasWithoutRays = 3;
+
 struct OccupancyScene::Impl {
   SceneOptions options;
-  octomap::OcTree tree;
-  // The distance field, copied out of DynamicEDTOctomap into one flat array (z fastest): a
-  // query is then a few multiplications and one load, not bounds checks and three levels of
-  // pointers. It covers the occupied voxels' bounding box grown by max_distance_m (within the
+  // The OctoMap: every camera's points inserted as rays. Tracing the rays is most of a
+  // scene's cost and only free space needs them, so the map is built when something asks
+  // about free space (occupancy_at, write_binary), not for planning.
+  mutable octomap::OcTree tree;
+  mutable bool tree_current = true;
+  struct Scan {
+    octomap::Pointcloud points;  // filtered, world frame
+    octomap::point3d origin;
+  };
+  std::vector<Scan> scans;
+  // The map's occupied voxels as octree keys (repeats included: one per point that hit).
+  std::vector<octomap::OcTreeKey> endpoint_keys;
+
+  // The distance field, one flat array (z fastest): a query is a few multiplications and one
+  // load. It covers the occupied voxels' bounding box grown by max_distance_m (within the
   // map box); everywhere else is at least that far from anything.
   bool built = false;
   std::vector<float> distance;
@@ -26,7 +40,53 @@ struct OccupancyScene::Impl {
   Eigen::Vector3i first_cell = Eigen::Vector3i::Zero();  // cell index of the field's first cell
   double cells_per_m = 0;
 
-  explicit Impl(const SceneOptions& o) : options(o), tree(o.resolution_m), cells_per_m(1.0 / o.resolution_m) {}
+  explicit Impl(const SceneOptions& o) : options(o), tree(o.resolution_m), cells_per_m(1.0 / o.resolution_m) {
+    // Rays are traced only inside the box: free space outside it is never asked about.
+    octomap::point3d lo(o.min_corner.x(), o.min_corner.y(), o.min_corner.z());
+    octomap::point3d hi(o.max_corner.x(), o.max_corner.y(), o.max_corner.z());
+    tree.setBBXMin(lo);
+    tree.setBBXMax(hi);
+    tree.useBBXLimit(true);
+  }
+
+  const octomap::OcTree& map() const {
+    if (!tree_current) {
+      tree.clear();
+      // discretize: one ray per endpoint voxel rather than per point (a quarter faster).
+      // lazy_eval, then inner nodes and pruning once: the same tree (the same .bt bytes) as
+      // updating them at every voxel, in about three quarters of the time.
+      for (const Scan& scan : scans)
+        tree.insertPointCloud(scan.points, scan.origin, -1.0, /*lazy_eval=*/true, /*discretize=*/true);
+      tree.updateInnerOccupancy();
+      tree.prune();
+      tree_current = true;
+    }
+    return tree;
+  }
+
+  // The map's occupied voxels without tracing a ray. Within one camera OctoMap lets a hit win
+  // over a miss, so a voxel's log-odds after n cameras is 0.85 h - 0.41 m for h hits and m
+  // misses, h + m <= n: once hit it stays occupied (>= 0) while m <= 2, i.e. for up to three
+  // cameras. More cameras: read the traced map. (test_occupancy_scene compares the two.)
+  std::vector<octomap::OcTreeKey> occupied_keys() const {
+    return scans.size() <= kCamerasWithoutRays ? endpoint_keys : traced_occupied_keys();
+  }
+
+  // The traced map's occupied voxels, each of them (a pruned node stands for a cube of them).
+  std::vector<octomap::OcTreeKey> traced_occupied_keys() const {
+    std::vector<octomap::OcTreeKey> keys;
+    const octomap::OcTree& t = map();
+    const unsigned depth = t.getTreeDepth();
+    for (auto it = t.begin_leafs(), end = t.end_leafs(); it != end; ++it) {
+      if (!t.isNodeOccupied(*it)) continue;
+      const int side = 1 << (depth - it.getDepth());
+      const octomap::OcTreeKey corner = it.getIndexKey();
+      for (int dx = 0; dx < side; ++dx)
+        for (int dy = 0; dy < side; ++dy)
+          for (int dz = 0; dz < side; ++dz) keys.emplace_back(corner[0] + dx, corner[1] + dy, corner[2] + dz);
+    }
+    return keys;
+  }
 
   // The cell containing `v`, as octomap's coordToKey computes it (less its key offset).
   int cell(double v) const { return static_cast<int>(std::floor(cells_per_m * v)); }
@@ -52,12 +112,6 @@ OccupancyScene::OccupancyScene(const SceneOptions& options) {
   if (!(options.max_corner.array() > options.min_corner.array()).all())
     throw Error("occupancy scene: max_corner must lie above min_corner on every axis");
   impl_ = std::make_unique<Impl>(options);
-  // Rays are traced only inside the box: free space outside it is never asked about.
-  octomap::point3d lo(options.min_corner.x(), options.min_corner.y(), options.min_corner.z());
-  octomap::point3d hi(options.max_corner.x(), options.max_corner.y(), options.max_corner.z());
-  impl_->tree.setBBXMin(lo);
-  impl_->tree.setBBXMax(hi);
-  impl_->tree.useBBXLimit(true);
 }
 
 OccupancyScene::~OccupancyScene() = default;
@@ -102,66 +156,53 @@ void OccupancyScene::insert_camera(const float* points_xyz, std::size_t count, c
     if (on_robot(p)) continue;
     cloud.push_back(p.x(), p.y(), p.z());
   }
-  // discretize: one ray per endpoint voxel rather than per point (a quarter faster at 256x256,
-  // even at 128x128). lazy_eval, then inner nodes and pruning once: the same tree (the same
-  // .bt bytes) as updating them at every voxel, in about three quarters of the time.
-  // bench_scene measures both.
-  octomap::OcTree& tree = impl_->tree;
-  tree.insertPointCloud(cloud, octomap::point3d(sensor_origin.x(), sensor_origin.y(), sensor_origin.z()), -1.0,
-                        /*lazy_eval=*/true, /*discretize=*/true);
-  tree.updateInnerOccupancy();
-  tree.prune();
-  impl_->built = false;  // stale now
+  // The endpoints' voxels, as OctoMap's discretised insertion takes them: the voxel of each
+  // point, kept when its centre lies in the box.
+  Impl& m = *impl_;
+  std::vector<octomap::OcTreeKey> keys;
+  keys.reserve(cloud.size());
+  for (const octomap::point3d& p : cloud) {
+    const octomap::OcTreeKey key = m.tree.coordToKey(p);
+    if (m.tree.inBBX(m.tree.keyToCoord(key))) keys.push_back(key);
+  }
+  m.endpoint_keys.insert(m.endpoint_keys.end(), keys.begin(), keys.end());
+  m.scans.push_back({std::move(cloud), octomap::point3d(sensor_origin.x(), sensor_origin.y(), sensor_origin.z())});
+  m.tree_current = false;
+  m.built = false;  // stale now
 }
 
 void OccupancyScene::build_distance_field() {
   Impl& m = *impl_;
   const SceneOptions& o = m.options;
-  octomap::OcTree& tree = m.tree;
   m.built = true;
   m.distance.clear();
   m.size.setZero();
+  const std::vector<octomap::OcTreeKey> occupied = m.occupied_keys();
+  if (occupied.empty()) return;  // nothing occupied: free everywhere
 
   // The occupied voxels' key bounds, grown by the saturation distance, within the map box.
-  const unsigned depth = tree.getTreeDepth();
   Eigen::Vector3i lo = Eigen::Vector3i::Constant(INT_MAX), hi = Eigen::Vector3i::Constant(INT_MIN);
-  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
-    if (!tree.isNodeOccupied(*it)) continue;
-    const octomap::OcTreeKey corner = it.getIndexKey();
-    const int side = 1 << (depth - it.getDepth());
+  for (const octomap::OcTreeKey& key : occupied)
     for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], static_cast<int>(corner[k]));
-      hi[k] = std::max(hi[k], corner[k] + side - 1);
+      lo[k] = std::min(lo[k], static_cast<int>(key[k]));
+      hi[k] = std::max(hi[k], static_cast<int>(key[k]));
     }
-  }
-  if (lo.x() > hi.x()) return;  // nothing occupied: free everywhere
   const int pad = static_cast<int>(std::ceil(o.max_distance_m * m.cells_per_m)) + 1;
-  const octomap::OcTreeKey box_lo = tree.coordToKey(octomap::point3d(o.min_corner.x(), o.min_corner.y(), o.min_corner.z()));
-  const octomap::OcTreeKey box_hi = tree.coordToKey(octomap::point3d(o.max_corner.x(), o.max_corner.y(), o.max_corner.z()));
+  const octomap::OcTreeKey box_lo = m.tree.coordToKey(octomap::point3d(o.min_corner.x(), o.min_corner.y(), o.min_corner.z()));
+  const octomap::OcTreeKey box_hi = m.tree.coordToKey(octomap::point3d(o.max_corner.x(), o.max_corner.y(), o.max_corner.z()));
   for (int k = 0; k < 3; ++k) {
     lo[k] = std::max(lo[k] - pad, static_cast<int>(box_lo[k]));
     hi[k] = std::min(hi[k] + pad, static_cast<int>(box_hi[k]));
   }
-  if ((lo.array() > hi.array()).any()) return;
-  const octomap::OcTreeKey key_lo(lo.x(), lo.y(), lo.z()), key_hi(hi.x(), hi.y(), hi.z());
-
-  const float max_distance = static_cast<float>(o.max_distance_m);
-  DynamicEDTOctomap edt(max_distance, &tree, tree.keyToCoord(key_lo), tree.keyToCoord(key_hi),
-                        /*treatUnknownAsOccupied=*/false);
-  edt.update();
 
   m.size = hi - lo + Eigen::Vector3i::Ones();
-  const int key_zero = tree.coordToKey(0.0);
-  m.first_cell = lo - Eigen::Vector3i::Constant(key_zero);
-  m.distance.resize(static_cast<std::size_t>(m.size.prod()));
-  std::size_t i = 0;
-  for (int x = lo.x(); x <= hi.x(); ++x)
-    for (int y = lo.y(); y <= hi.y(); ++y)
-      for (int z = lo.z(); z <= hi.z(); ++z, ++i)
-        m.distance[i] = std::min(edt.getDistance_unsafe(octomap::OcTreeKey(x, y, z)), max_distance);
-  // The EDT turned change tracking on for its own incremental updates; it is gone now.
-  tree.enableChangeDetection(false);
-  tree.resetChangeDetection();
+  m.first_cell = lo - Eigen::Vector3i::Constant(m.tree.coordToKey(0.0));
+  std::vector<uint8_t> grid(static_cast<std::size_t>(m.size.prod()), 0);
+  for (const octomap::OcTreeKey& key : occupied)
+    grid[(static_cast<std::size_t>(key[0] - lo.x()) * m.size.y() + (key[1] - lo.y())) * m.size.z() + (key[2] - lo.z())] = 1;
+  m.distance = squared_distance_transform(grid, m.size, o.threads);
+  const float max_distance = static_cast<float>(o.max_distance_m), metres_per_cell = static_cast<float>(o.resolution_m);
+  for (float& d : m.distance) d = std::min(std::sqrt(d) * metres_per_cell, max_distance);
 }
 
 double OccupancyScene::distance_m(const Eigen::Vector3d& p) const {
@@ -177,35 +218,18 @@ bool OccupancyScene::collides(const std::vector<Sphere>& spheres, double clearan
 }
 
 OccupancyScene::Occupancy OccupancyScene::occupancy_at(const Eigen::Vector3d& p) const {
-  const octomap::OcTreeNode* node = impl_->tree.search(p.x(), p.y(), p.z());
+  const octomap::OcTreeNode* node = impl_->map().search(p.x(), p.y(), p.z());
   if (!node) return Occupancy::unknown;
-  return impl_->tree.isNodeOccupied(node) ? Occupancy::occupied : Occupancy::free;
+  return impl_->map().isNodeOccupied(node) ? Occupancy::occupied : Occupancy::free;
 }
 
-std::size_t OccupancyScene::occupied_voxels() const {
-  const octomap::OcTree& tree = impl_->tree;
-  const unsigned depth = tree.getTreeDepth();
-  std::size_t n = 0;
-  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it)
-    if (tree.isNodeOccupied(*it)) n += std::size_t{1} << (3 * (depth - it.getDepth()));
-  return n;
-}
+std::size_t OccupancyScene::occupied_voxels() const { return impl_->traced_occupied_keys().size(); }
 
 std::vector<Eigen::Vector3d> OccupancyScene::occupied_voxel_centres() const {
-  const octomap::OcTree& tree = impl_->tree;
-  const unsigned depth = tree.getTreeDepth();
   std::vector<Eigen::Vector3d> centres;
-  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
-    if (!tree.isNodeOccupied(*it)) continue;
-    // A pruned node stands for a cube of voxels; list each of them.
-    const int side = 1 << (depth - it.getDepth());
-    const octomap::OcTreeKey corner = it.getIndexKey();
-    for (int dx = 0; dx < side; ++dx)
-      for (int dy = 0; dy < side; ++dy)
-        for (int dz = 0; dz < side; ++dz) {
-          const octomap::point3d c = tree.keyToCoord(octomap::OcTreeKey(corner[0] + dx, corner[1] + dy, corner[2] + dz));
-          centres.emplace_back(c.x(), c.y(), c.z());
-        }
+  for (const octomap::OcTreeKey& key : impl_->traced_occupied_keys()) {
+    const octomap::point3d c = impl_->tree.keyToCoord(key);
+    centres.emplace_back(c.x(), c.y(), c.z());
   }
   return centres;
 }
@@ -213,7 +237,7 @@ std::vector<Eigen::Vector3d> OccupancyScene::occupied_voxel_centres() const {
 void OccupancyScene::write_binary(const std::string& path) const {
   // writeBinaryConst: the same format as writeBinary, without thresholding our own tree.
   std::ostringstream bytes;
-  if (!impl_->tree.writeBinaryConst(bytes)) throw Error(path + ": could not serialise the octree");
+  if (!impl_->map().writeBinaryConst(bytes)) throw Error(path + ": could not serialise the octree");
   const std::string data = bytes.str();
   write_file_atomically(path, data.data(), data.size());
 }

@@ -1,6 +1,8 @@
 // The scene as the camera saw it: an OctoMap built from an observation's point clouds (camera
 // rays inserted, so free and unknown space are known), with the robot's own links and a held
-// object filtered out, and a Euclidean distance field over it for collision checks.
+// object filtered out, and a Euclidean distance field over its occupied voxels for collision
+// checks. The rays are traced only when free space is asked about: planning needs the
+// occupied voxels alone, and those follow from the endpoints (see occupancy_scene.cpp).
 #pragma once
 
 #include <Eigen/Geometry>
@@ -20,6 +22,7 @@ struct SceneOptions {
   Eigen::Vector3d max_corner{0.9, 0.8, 1.8};
   double max_distance_m = 0.2;     // the distance field saturates here
   double robot_filter_margin_m = 0.02;  // points this close to the robot's spheres are its own
+  int threads = 1;                 // for the distance transform
 };
 
 class OccupancyScene {
@@ -46,11 +49,11 @@ class OccupancyScene {
   // True when some sphere is closer to an occupied voxel than its radius plus `clearance_m`.
   bool collides(const std::vector<Sphere>& spheres, double clearance_m = 0.0) const;
 
-  // Occupied voxels at the map resolution (pruned octree nodes count for all they cover).
   // What the map knows about the point: never observed, observed free, or occupied.
   enum class Occupancy { unknown, free, occupied };
   Occupancy occupancy_at(const Eigen::Vector3d& p) const;
 
+  // Occupied voxels of the traced map at its resolution (pruned nodes count for all they cover).
   std::size_t occupied_voxels() const;
   // Their centres, world frame: for tests and visualisation.
   std::vector<Eigen::Vector3d> occupied_voxel_centres() const;

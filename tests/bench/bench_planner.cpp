@@ -1,10 +1,13 @@
 // Prints planner figures: success rate and median / 95th-percentile planning time over random
 // reachable goals in task scenes, scene (OctoMap + distance field) build time, IK time.
+// --decisions FILE: one line per goal (task, scene, goal, outcome, waypoints, duration), to
+// diff the planner's decisions between two builds.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <map>
 #include <random>
+#include <string>
 
 #include "planning/motion_planner.hpp"
 #include "simulator/simulator.hpp"
@@ -20,7 +23,8 @@ static double percentile(std::vector<double> v, double p) {
 
 static double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-int main() {
+int main(int argc, char** argv) {
+  std::FILE* decisions = argc == 3 && std::string(argv[1]) == "--decisions" ? std::fopen(argv[2], "w") : nullptr;
   const robot::RobotModel robot = robot::RobotModel::xarm7();
   const Eigen::Isometry3d base = sim::SceneLayout{}.robot_base_pose();
   std::mt19937 rng(11);
@@ -73,7 +77,11 @@ int main() {
         scene_times.push_back(seconds_since(t0));
         const planning::PlanResult plan = planner.plan(start, goal, scene, goals);
         plan_times.push_back(plan.planning_time_s);
-        outcomes[plan.failure.empty() ? "ok:" + plan.method : plan.failure] += 1;
+        const std::string outcome = plan.failure.empty() ? "ok:" + plan.method : plan.failure;
+        outcomes[outcome] += 1;
+        if (decisions)
+          std::fprintf(decisions, "%s %d %d %s %zu %.6f\n", task, scene_index, g, outcome.c_str(),
+                       plan.time_s.size(), plan.time_s.empty() ? 0.0 : plan.time_s.back());
         ++goals;
       }
     }
@@ -86,4 +94,5 @@ int main() {
               1e3 * percentile(plan_times, 0.5), 1e3 * percentile(plan_times, 0.95));
   std::printf("scene build (OctoMap insertion + distance field, 128x128 front camera): median %.0f ms, p95 %.0f ms\n",
               1e3 * percentile(scene_times, 0.5), 1e3 * percentile(scene_times, 0.95));
+  if (decisions) std::fclose(decisions);
 }

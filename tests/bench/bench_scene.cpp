@@ -1,13 +1,18 @@
-// Prints occupancy scene figures on a pick_and_lift observation: octree insertion per front
-// camera frame (128x128 and 256x256; and plain OctoMap with and without discretize and the
-// box limit), distance field build, distance queries and robot sphere-set checks per second.
+// Prints occupancy scene figures on a pick_and_lift observation, per front camera frame
+// (128x128 and 256x256): the planning scene (occupied voxels from the endpoints and the
+// distance transform, 1 and 2 threads), the traced OctoMap, the former scene (traced map and
+// dynamicEDT3D) side by side with how far its field is from today's, plain OctoMap with and
+// without discretize and the box limit; then distance queries and robot sphere-set checks per
+// second.
 // Medians of several runs.
+#include <dynamicEDT3D/dynamicEDTOctomap.h>
 #include <octomap/OcTree.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <functional>
+#include <memory>
 #include <random>
 
 #include "planning/occupancy_scene.hpp"
@@ -85,6 +90,56 @@ double plain_octomap_ms(const Frame& frame, bool discretize, bool lazy_eval, boo
   });
 }
 
+// The former scene, measured beside today's as the peer: the traced OctoMap and
+// dynamicEDT3D's field over its occupied voxels' box grown by the saturation distance.
+// Returns its milliseconds; counts the cells where its field differs from `scene`'s.
+double former_scene_ms(const Frame& frame, const OccupancyScene& scene, std::size_t* cells, std::size_t* differing,
+                       double* largest_difference) {
+  const SceneOptions o;
+  octomap::OcTree tree(o.resolution_m);
+  std::unique_ptr<DynamicEDTOctomap> edt;
+  octomap::OcTreeKey lo, hi;
+  const double ms = 1e3 * median_s(3, [&] {
+    OccupancyScene traced;
+    traced.insert_camera(frame.points.data(), frame.points.size() / 3, frame.origin, frame.robot, {});
+    traced.occupancy_at(frame.origin);  // traces the rays
+    tree.clear();
+    octomap::point3d bmin(o.min_corner.x(), o.min_corner.y(), o.min_corner.z());
+    octomap::point3d bmax(o.max_corner.x(), o.max_corner.y(), o.max_corner.z());
+    const std::vector<Eigen::Vector3d> occupied = traced.occupied_voxel_centres();
+    for (const Eigen::Vector3d& c : occupied) tree.updateNode(c.x(), c.y(), c.z(), true, true);
+    tree.updateInnerOccupancy();
+    const int pad = static_cast<int>(std::ceil(o.max_distance_m / o.resolution_m)) + 1;
+    lo = hi = tree.coordToKey(occupied.front().x(), occupied.front().y(), occupied.front().z());
+    for (const Eigen::Vector3d& c : occupied) {
+      const octomap::OcTreeKey k = tree.coordToKey(c.x(), c.y(), c.z());
+      for (int i = 0; i < 3; ++i) lo[i] = std::min(lo[i], k[i]), hi[i] = std::max(hi[i], k[i]);
+    }
+    const octomap::OcTreeKey box_lo = tree.coordToKey(bmin), box_hi = tree.coordToKey(bmax);
+    for (int i = 0; i < 3; ++i) {
+      lo[i] = std::max<int>(lo[i] - pad, box_lo[i]);
+      hi[i] = std::min<int>(hi[i] + pad, box_hi[i]);
+    }
+    edt = std::make_unique<DynamicEDTOctomap>(static_cast<float>(o.max_distance_m), &tree, tree.keyToCoord(lo),
+                                              tree.keyToCoord(hi), false);
+    edt->update();
+  });
+  *cells = *differing = 0;
+  *largest_difference = 0;
+  for (int x = lo[0]; x <= hi[0]; ++x)
+    for (int y = lo[1]; y <= hi[1]; ++y)
+      for (int z = lo[2]; z <= hi[2]; ++z) {
+        const octomap::OcTreeKey key(x, y, z);
+        const octomap::point3d c = tree.keyToCoord(key);
+        const double former = std::min<double>(edt->getDistance_unsafe(key), o.max_distance_m);
+        const double d = std::abs(former - scene.distance_m(Eigen::Vector3d(c.x(), c.y(), c.z())));
+        ++*cells;
+        *differing += d > 1e-5;
+        *largest_difference = std::max(*largest_difference, d);
+      }
+  return ms;
+}
+
 }  // namespace
 
 int main() {
@@ -96,14 +151,32 @@ int main() {
   for (int size : {128, 256}) {
     const Frame frame = observe(robot, spheres, size);
     const std::size_t count = frame.points.size() / 3;
-    const double insert_ms = 1e3 * median_s(7, [&] {
-      OccupancyScene s;
+    auto planning_scene = [&](int threads) {
+      SceneOptions o;
+      o.threads = threads;
+      OccupancyScene s(o);
       s.insert_camera(frame.points.data(), count, frame.origin, frame.robot, {});
+      s.build_distance_field();
+      return s;
+    };
+    std::printf("front %dx%d:\n", size, size);
+    for (int threads : {1, 2})
+      std::printf("  planning scene (endpoints + distance field), %d thread%s: %.1f ms\n", threads,
+                  threads > 1 ? "s" : "", 1e3 * median_s(9, [&] { planning_scene(threads); }));
+    OccupancyScene s = planning_scene(1);
+    const double traced_ms = 1e3 * median_s(5, [&] {
+      OccupancyScene t;
+      t.insert_camera(frame.points.data(), count, frame.origin, frame.robot, {});
+      t.occupancy_at(frame.origin);
     });
-    OccupancyScene s;
-    s.insert_camera(frame.points.data(), count, frame.origin, frame.robot, {});
-    std::printf("front %dx%d: insert_camera %.1f ms (%zu occupied voxels)\n", size, size, insert_ms,
-                s.occupied_voxels());
+    std::printf("  traced OctoMap (rays; what --octomap and occupancy queries cost): %.1f ms, %zu occupied voxels\n",
+                traced_ms, s.occupied_voxels());
+    std::size_t cells = 0, differing = 0;
+    double largest = 0;
+    const double former_ms = former_scene_ms(frame, s, &cells, &differing, &largest);
+    std::printf("  former scene (traced OctoMap + dynamicEDT3D): %.1f ms; its field differs from today's in %zu of %zu "
+                "cells (largest difference %.4f m)\n",
+                former_ms, differing, cells, largest);
     for (bool box_limit : {false, true})
       for (bool discretize : {false, true})
         for (bool lazy_eval : {false, true}) {
@@ -112,16 +185,7 @@ int main() {
           std::printf("  plain insertPointCloud box_limit=%d discretize=%d lazy_eval=%d: %.1f ms (%zu leaves)\n",
                       box_limit, discretize, lazy_eval, ms, leaves);
         }
-    const double build_ms = 1e3 * median_s(5, [&] {
-      OccupancyScene t;
-      t.insert_camera(frame.points.data(), count, frame.origin, frame.robot, {});
-      t.build_distance_field();
-    }) - insert_ms;
-    std::printf("  build_distance_field: %.1f ms\n", build_ms);
-    if (size == 128) {
-      s.build_distance_field();
-      scene = std::move(s);
-    }
+    if (size == 128) scene = std::move(s);
   }
 
   // Distance queries at random points in the box.

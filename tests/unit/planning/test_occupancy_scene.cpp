@@ -6,6 +6,9 @@
 
 #include <dirent.h>
 #include <fstream>
+#include <random>
+#include <set>
+#include <tuple>
 #include <sstream>
 
 #include "planning/occupancy_scene.hpp"
@@ -195,4 +198,103 @@ TEST(OccupancyScene, QueriesNeedTheDistanceField) {
   s.build_distance_field();
   EXPECT_EQ(s.distance_m(Eigen::Vector3d(0, 0, 1)), SceneOptions{}.max_distance_m);  // empty: all free
   EXPECT_THROW(OccupancyScene(SceneOptions{0.0}), Error);
+}
+
+namespace {
+
+// The scene of one pick_and_lift observation seen by `cameras`, and the traced map's occupied
+// voxel centres as cell indices.
+struct SeenScene {
+  OccupancyScene scene;
+  std::vector<Eigen::Vector3i> occupied_cells;
+};
+
+SeenScene seen_by(const std::vector<std::string>& cameras) {
+  simulator::SimulatorOptions options;
+  options.cameras.clear();
+  for (const auto& name : cameras) {
+    options.cameras.push_back({name, {}});
+    options.cameras.back().intrinsics.width = options.cameras.back().intrinsics.height = 96;
+  }
+  simulator::Simulator simulator(xarm(), options);
+  stream::Record reset("reset"), obs("obs");
+  reset.set_string("task", "pick_and_lift");
+  reset.set_scalar<int32_t>("variation", 0);
+  reset.set_scalar<int64_t>("seed", 5);
+  simulator.handle(reset, [&](const stream::Record& o) { obs = o; });
+  SeenScene seen;
+  std::vector<Sphere> robot;
+  static const RobotSpheres spheres(xarm());
+  spheres.place(simulator.world()->joint_positions(), simulator.world()->finger_opening_m(),
+                simulator.world()->robot_base_pose(), robot);
+  for (const auto& name : cameras) {
+    const auto points = obs.array<float>(name + ".points");
+    const auto e = obs.array<double>(name + ".extrinsics");
+    seen.scene.insert_camera(points.data, static_cast<std::size_t>(points.size() / 3),
+                             Eigen::Vector3d(e[3], e[7], e[11]), robot, {});
+  }
+  seen.scene.build_distance_field();
+  for (const Eigen::Vector3d& c : seen.scene.occupied_voxel_centres())
+    seen.occupied_cells.push_back((c / kResolution).array().floor().cast<int>());
+  return seen;
+}
+
+}  // namespace
+
+// Planning reads the occupied voxels off the endpoints, without tracing rays: for up to three
+// cameras they are exactly the traced map's, and the field is the exact distance to them.
+TEST(OccupancyScene, TheDistanceFieldIsExactToTheTracedMapsOccupiedVoxels) {
+  for (const std::vector<std::string>& cameras :
+       {std::vector<std::string>{"front"}, {"front", "wrist"}, {"front", "wrist", "overhead"}}) {
+    const SeenScene seen = seen_by(cameras);
+    ASSERT_GT(seen.occupied_cells.size(), 500u);
+    Eigen::Vector3i lo = seen.occupied_cells[0], hi = lo;
+    for (const auto& c : seen.occupied_cells) lo = lo.cwiseMin(c), hi = hi.cwiseMax(c);
+    // Every cell of their bounding box (and one beyond): distance 0 exactly on the traced
+    // occupied voxels.
+    std::set<std::tuple<int, int, int>> traced;
+    for (const auto& c : seen.occupied_cells) traced.emplace(c.x(), c.y(), c.z());
+    std::size_t zero = 0, mismatched = 0;
+    for (int x = lo.x() - 1; x <= hi.x() + 1; ++x)
+      for (int y = lo.y() - 1; y <= hi.y() + 1; ++y)
+        for (int z = lo.z() - 1; z <= hi.z() + 1; ++z) {
+          const bool field_zero = seen.scene.distance_m((Eigen::Vector3d(x, y, z).array() + 0.5) * kResolution) == 0;
+          zero += field_zero;
+          mismatched += field_zero != traced.count({x, y, z});
+        }
+    EXPECT_EQ(mismatched, 0u) << cameras.size() << " cameras";
+    EXPECT_EQ(zero, traced.size());
+    // Elsewhere, the Euclidean distance between voxel centres to the nearest of them.
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (int i = 0; i < 300; ++i) {
+      const Eigen::Vector3d p = (lo.cast<double>().array() +
+                                 (hi - lo).cast<double>().array() * Eigen::Array3d(u(rng), u(rng), u(rng)) + 0.5) *
+                                kResolution;
+      const Eigen::Vector3d centre = ((p / kResolution).array().floor() + 0.5) * kResolution;
+      double nearest = SceneOptions{}.max_distance_m;
+      for (const auto& c : seen.occupied_cells)
+        nearest = std::min(nearest, (centre - (c.cast<double>().array() + 0.5).matrix() * kResolution).norm());
+      EXPECT_NEAR(seen.scene.distance_m(p), nearest, 1e-6) << p.transpose();
+    }
+  }
+}
+
+// Four cameras: a voxel one camera hit and three saw through is free in the map (0.85 - 3 x
+// 0.41 < 0), and so in the field; with two of them seeing through it stays occupied.
+TEST(OccupancyScene, FromFourCamerasOnTheTracedMapDecides) {
+  const Eigen::Vector3d voxel(0.305, 0.005, 1.005), behind(0.105, 0.005, 1.005);
+  for (int through : {2, 3}) {
+    OccupancyScene s;
+    const float hit[] = {float(voxel.x()), float(voxel.y()), float(voxel.z())};
+    const float far[] = {float(behind.x()), float(behind.y()), float(behind.z())};
+    s.insert_camera(hit, 1, Eigen::Vector3d(-0.2, 0.005, 1.005), {}, {});
+    for (int i = 0; i < through; ++i) s.insert_camera(far, 1, Eigen::Vector3d(0.605, 0.005, 1.005), {}, {});
+    s.build_distance_field();
+    const bool occupied = through == 2;
+    EXPECT_EQ(s.occupancy_at(voxel) == OccupancyScene::Occupancy::occupied, occupied) << through;
+    // Free, it is as far as the nearest hit behind it: 20 cm.
+    EXPECT_NEAR(s.distance_m(voxel), occupied ? 0.0 : 0.2, 1e-6) << through;
+    EXPECT_EQ(s.distance_m(behind), 0.0);
+  }
 }
