@@ -176,6 +176,6 @@ static void run(const cli::Arguments& args) {
 }
 
 int main(int argc, char** argv) {
-  nets::use_passive_openmp_waits(argv);
+  nets::prepare_process_for_networks(argv);
   return cli::run_tool(argc, argv, usage(), run);
 }

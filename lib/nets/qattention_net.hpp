@@ -86,12 +86,13 @@ void seed_torch(uint64_t seed);
 // Intra-op threads of LibTorch (its default is every core).
 void set_torch_threads(int threads);
 
+// Programs that run networks call this first thing in main().
 // LibTorch's OpenMP threads spin while they wait for work. When two programs share the cores
 // (the learner and the actor of the learning loop on 2 cores), a spinning thread takes the
 // core its partner needs: we measured steps 5x and acting 50x slower. libgomp reads
-// OMP_WAIT_POLICY once, when it loads, so programs that run networks call this first thing in
-// main(): unless the user has set OMP_WAIT_POLICY, it sets it to PASSIVE and executes the
-// program again (same arguments). Returns only when nothing needs to change.
-void use_passive_openmp_waits(char** argv);
+// OMP_WAIT_POLICY once, when it loads, so unless the user has set it, this sets it to PASSIVE
+// and executes the program again (same arguments). Then it keeps freed activations in the
+// heap for the next forward (see the .cpp).
+void prepare_process_for_networks(char** argv);
 
 }  // namespace qte::nets

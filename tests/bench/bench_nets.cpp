@@ -161,7 +161,7 @@ void export_reference_check(const std::string& dir) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  qte::nets::use_passive_openmp_waits(argv);  // fair figures while other programs run
+  qte::nets::prepare_process_for_networks(argv);  // fair figures while other programs run
   bool quick = false, sweep = false;
   int threads = 2;
   std::string export_dir;

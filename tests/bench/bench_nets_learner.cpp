@@ -34,7 +34,7 @@ static double median(std::vector<double> v) {
 }
 
 int main(int argc, char** argv) {
-  qte::nets::use_passive_openmp_waits(argv);  // fair figures while other programs run
+  qte::nets::prepare_process_for_networks(argv);  // fair figures while other programs run
   std::string arch = "light";
   int batch = 32, tree = 0, steps = 5, threads = 2, compare = 0;
   for (int i = 1; i + 1 < argc; i += 2) {

@@ -36,7 +36,7 @@ struct Variant {
 }  // namespace
 
 int main(int argc, char** argv) {
-  use_passive_openmp_waits(argv);
+  prepare_process_for_networks(argv);
   std::string arch = "light";
   int grids = 352, threads = 1, reps = 5;
   bool last = false;

@@ -12,7 +12,7 @@ using namespace qte;
 using Clock = std::chrono::steady_clock;
 
 int main(int, char** argv) {
-  qte::nets::use_passive_openmp_waits(argv);  // fair figures while other programs run
+  qte::nets::prepare_process_for_networks(argv);  // fair figures while other programs run
   nets::set_torch_threads(2);
   std::mt19937 rng(1);
   std::uniform_real_distribution<float> u(0, 1);
