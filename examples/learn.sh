@@ -7,6 +7,7 @@
 #   sim-step < loop | qte-select --reload | plan-path | tee loop | keyframe --agent --append
 #                                               the actor: a closed pipeline through a FIFO;
 #                                               every finished episode is appended to replay.rec
+#                                               (ACTORS of them at once, each on its own chunk)
 #   sim-step | qte-select (greedy) | plan-path | episode-stats
 #                                               evaluation on held-out seeds after each chunk
 #
@@ -17,13 +18,22 @@
 # Usage: learn.sh TASK RUN_DIR   (settings from the environment; see examples/Makefile)
 # Resumable: finished chunks and evaluations are kept, the learner resumes from its last
 # checkpoint; an interrupted chunk is run again (its finished episodes stay in the replay).
+#
+# ACTORS=N runs N actor pipelines side by side, each on its own chunk of episodes (chunk c
+# explores the scenes of seed SEED * 100000 + c, whichever actor runs it), all appending to
+# the one replay file the learner follows (whole records under a lock; an episode's frames
+# come before its transitions, and episodes are told apart by their keys). A machine with more
+# cores collects experience N times as fast. With N > 1 the order in which episodes reach the
+# replay depends on timing, so a run is no longer a function of its seed alone. An actor that
+# dies (killed, out of memory) costs only its own chunk: the others finish theirs and the
+# chunk is run again in the next round (twice failed: the run stops).
 set -euo pipefail
 task=$1 run=$2
 : "${SEED:=0}" "${DEMOS:=10}" "${VARIATION:=0}" "${IMAGE:=128x128}" "${ACT_K:=10}" "${TARGET_K:=10}"
 : "${ENV_STEPS:=2000}" "${CHUNK_EPISODES:=10}" "${EVAL_EVERY:=250}" "${EVAL_EPISODES:=50}" "${EVAL_SEED:=1000000}"
 : "${ARCH:=light}" "${BATCH:=32}" "${RATIO:=0.5}" "${PRETRAIN:=200}" "${START_AFTER:=0}"
 : "${LEARNER_THREADS:=1}" "${EPSILON:=0.1}" "${ROTATION_NOISE:=1}" "${CHECKPOINT_EVERY:=25}" "${LABEL:=k$ACT_K-$TARGET_K}"
-: "${N_STEP:=1}"
+: "${N_STEP:=1}" "${ACTORS:=1}"
 mkdir -p "$run/chunks" "$run/eval"
 log() { printf '%s %s\n' "$(date +%H:%M:%S)" "$*" >&2; }
 
@@ -43,7 +53,7 @@ qattn-train --follow --resume --stop-file "$run/actor.done" --replay-ratio "$RAT
   --architecture "$ARCH" --batch "$BATCH" --tree-target "$TARGET_K" --n-step "$N_STEP" --seed "$SEED" --threads "$LEARNER_THREADS" \
   --checkpoint-dir "$run/ckpt" --metrics "$run/train.csv" "$run/replay.rec" 2>> "$run/train.log" &
 learner=$!
-trap 'kill $learner 2>/dev/null || true' EXIT
+trap 'kill $(jobs -p) 2>/dev/null || true' EXIT  # the learner and any actor still running
 while [ ! -f "$run/ckpt/latest.rec" ]; do kill -0 $learner || { tail -2 "$run/train.log"; exit 1; }; sleep 0.5; done
 
 # The learner's newest step, from its checkpoint names.
@@ -70,8 +80,39 @@ evaluate() {  # CHECKPOINT ENV_STEPS OUT.csv LEARNER_STEP EVAL_POINT
   mv "$3.tmp" "$3"
 }
 
-env_steps=0 chunk=0
+# One chunk of exploring episodes through the closed loop -> chunks/NNNN.rec and its step
+# count in chunks/NNNN.steps.
+run_chunk() {  # CHUNK
+  local name fifo seed
+  name=$run/chunks/$(printf '%04d' "$1") seed=$((SEED * 100000 + $1))
+  fifo=$(mktemp -u); mkfifo "$fifo"
+  if ! sim-step --task "$task" --variation "$VARIATION" --episodes "$CHUNK_EPISODES" --seed "$seed" \
+      --scenes explore --image-size "$IMAGE" --compress < "$fifo" \
+    | qte-select --checkpoint "$run/ckpt/latest.rec" --reload --k "$ACT_K" --epsilon "$EPSILON" \
+        --rotation-noise "$ROTATION_NOISE" --seed "$seed" --threads 1 2>> "$run/actor.log" \
+    | plan-path | tee "$fifo" "$name.partial" \
+    | keyframe --agent --seed "$SEED" --append --output "$run/replay.rec" 2>> "$run/actor.log"; then
+    rm -f "$fifo"
+    return 1
+  fi
+  rm -f "$fifo"
+  stream-dump --summary "$name.partial" | awk '$1 == "action" { print $2 }' > "$name.steps"
+  mv "$name.partial" "$name.rec"
+}
+# Environment steps of the finished chunks (counted once per chunk).
+finished_steps() {
+  local f n=0
+  for f in "$run"/chunks/*.rec; do
+    [ -f "$f" ] || continue
+    [ -f "${f%.rec}.steps" ] || stream-dump --summary "$f" | awk '$1 == "action" { print $2 }' > "${f%.rec}.steps"
+    n=$(( n + $(cat "${f%.rec}.steps") ))
+  done
+  echo "$n"
+}
+
+declare -A failures=()
 while :; do
+  env_steps=$(finished_steps)
   # Every EVAL_EVERY environment steps and at the end: evaluate what the learner has made of
   # the experience so far, once it has taken the steps the replay ratio allows.
   mark=$(( env_steps >= ENV_STEPS ? 999999 : env_steps / EVAL_EVERY ))
@@ -85,22 +126,22 @@ while :; do
   fi
   [ "$env_steps" -ge "$ENV_STEPS" ] && break
 
-  # One chunk of exploring episodes through the closed loop.
-  name=$run/chunks/$(printf '%04d' "$chunk")
-  if [ ! -f "$name.rec" ]; then
-    fifo=$(mktemp -u); mkfifo "$fifo"
-    sim-step --task "$task" --variation "$VARIATION" --episodes "$CHUNK_EPISODES" --seed $((SEED * 100000 + chunk)) \
-      --scenes explore \
-      --image-size "$IMAGE" --compress < "$fifo" \
-      | qte-select --checkpoint "$run/ckpt/latest.rec" --reload --k "$ACT_K" --epsilon "$EPSILON" \
-          --rotation-noise "$ROTATION_NOISE" --seed $((SEED * 100000 + chunk)) --threads 1 2>> "$run/actor.log" \
-      | plan-path | tee "$fifo" "$name.partial" \
-      | keyframe --agent --seed "$SEED" --append --output "$run/replay.rec" 2>> "$run/actor.log"
-    rm -f "$fifo"
-    mv "$name.partial" "$name.rec"
-  fi
-  env_steps=$(( env_steps + $(stream-dump --summary "$name.rec" | awk '$1 == "action" { print $2 }') ))
-  chunk=$((chunk + 1))
+  # One round: the next ACTORS chunks not yet finished, side by side.
+  round=() chunk=0
+  while [ "${#round[@]}" -lt "$ACTORS" ]; do
+    [ -f "$run/chunks/$(printf '%04d' "$chunk").rec" ] || round+=("$chunk")
+    chunk=$((chunk + 1))
+  done
+  pids=()
+  for c in "${round[@]}"; do run_chunk "$c" & pids+=($!); done
+  for i in "${!round[@]}"; do
+    c=${round[$i]}
+    if ! wait "${pids[$i]}"; then
+      failures[$c]=$(( ${failures[$c]:-0} + 1 ))
+      log "$task $LABEL seed $SEED: the actor of chunk $c failed (attempt ${failures[$c]}); its finished episodes stay in the replay"
+      [ "${failures[$c]}" -lt 2 ] || { log "chunk $c failed twice: stopping"; exit 1; }
+    fi
+  done
 done
 touch "$run/actor.done"
 wait $learner || true
