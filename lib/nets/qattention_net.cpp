@@ -90,7 +90,15 @@ void seed_torch(uint64_t seed) { torch::manual_seed(seed); }
 void prepare_process_for_networks(char** argv) {
   if (std::getenv("OMP_WAIT_POLICY") == nullptr) {
     ::setenv("OMP_WAIT_POLICY", "PASSIVE", 1);
-    ::execv("/proc/self/exe", argv);  // on failure, carry on with spinning waits
+    // By its own path, so that the process keeps its name (ps, pgrep, perf: "qte-select", not
+    // "exe"); failing that, through /proc; failing both, carry on with spinning waits.
+    char self[4096];
+    const ssize_t length = ::readlink("/proc/self/exe", self, sizeof self - 1);
+    if (length > 0) {
+      self[length] = '\0';
+      ::execv(self, argv);
+    }
+    ::execv("/proc/self/exe", argv);
   }
   // A forward allocates and frees megabytes of activations. glibc maps blocks that large
   // with mmap and trims the heap on free, so every forward faulted its pages in anew: acting

@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include <ATen/autocast_mode.h>
+
 #include "nets/qattention_modules.hpp"
 
 using namespace qte::nets;
@@ -72,19 +74,25 @@ int main(int argc, char** argv) {
   }
   const auto input = torch::from_blob(data.data(), {grids, v, v, v, c});
   const auto state = torch::from_blob(proprio.data(), {grids, config.proprio});
-  const auto chunked = [&](QAttentionNet& net, int chunk, bool channels_last, bool inference_mode) {
-    return [&, chunk, channels_last, inference_mode] {
+  const auto chunked = [&](QAttentionNet& net, int chunk, bool channels_last, bool inference_mode,
+                           bool bfloat16 = false) {
+    return [&, chunk, channels_last, inference_mode, bfloat16] {
       std::unique_ptr<c10::InferenceMode> im;
       std::unique_ptr<torch::NoGradGuard> ng;
       if (inference_mode) im = std::make_unique<c10::InferenceMode>();
       else ng = std::make_unique<torch::NoGradGuard>();
+      // CPU autocast: convolutions and matrix products in bfloat16 (AVX-512 BF16 here).
+      at::autocast::set_cpu_enabled(bfloat16);
+      at::autocast::set_autocast_cpu_dtype(at::kBFloat16);
       for (int first = 0; first < grids; first += chunk) {
         const int n = std::min(chunk, grids - first);
         const auto g = input.slice(0, first, first + n).permute({0, 4, 1, 2, 3});
         const auto x = channels_last ? g.contiguous(torch::MemoryFormat::ChannelsLast3d) : g.contiguous();
         const QOutputs out = net.module().forward(x, state.slice(0, first, first + n));
-        (void)out.translation.contiguous().data_ptr<float>();
+        (void)out.translation.to(torch::kFloat).contiguous().data_ptr<float>();
       }
+      at::autocast::set_cpu_enabled(false);
+      at::autocast::clear_cache();
     };
   };
   std::vector<Variant> variants;
@@ -94,6 +102,8 @@ int main(int argc, char** argv) {
   for (int chunk : {16, 32})
     variants.push_back({"NDHWC chunk " + std::to_string(chunk), chunked(nhwc, chunk, true, false), {}});
   variants.push_back({"NCDHW chunk 32 inference mode", chunked(nchw, 32, false, true), {}});
+  variants.push_back({"NCDHW chunk 32 inference, bf16 autocast", chunked(nchw, 32, false, true, true), {}});
+  variants.push_back({"NDHWC chunk 32 inference, bf16 autocast", chunked(nhwc, 32, true, true, true), {}});
   for (auto& variant : variants) variant.run();  // warm-up
   for (int r = 0; r < reps; ++r)
     for (auto& variant : variants) {
