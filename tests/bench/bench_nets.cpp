@@ -8,6 +8,7 @@
 // Compare with the PyTorch reference, run back to back:
 //   /usr/bin/python3 shared/bench/torch_qattention_ref.py 2
 // Options: --quick (skip arm at batch 128), --sweep (light at 8..32 base channels),
+//          --light (one line: light's b32 step at depth 0 and the last, for bench_light_vs_torch),
 //          --threads N (default 2), --export DIR (files for torch_reference_step.py, which
 //          checks our arm network against the reference's forward pass and training step).
 #include <algorithm>
@@ -162,7 +163,7 @@ void export_reference_check(const std::string& dir) {
 
 int main(int argc, char** argv) {
   qte::nets::prepare_process_for_networks(argv);  // fair figures while other programs run
-  bool quick = false, sweep = false;
+  bool quick = false, sweep = false, light_only = false;
   int threads = 2;
   std::string export_dir;
   for (int i = 1; i < argc; ++i) {
@@ -170,6 +171,8 @@ int main(int argc, char** argv) {
       quick = true;
     else if (!std::strcmp(argv[i], "--sweep"))
       sweep = true;
+    else if (!std::strcmp(argv[i], "--light"))
+      light_only = true;
     else if (!std::strcmp(argv[i], "--channels-last"))
       channels_last = true;
     else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc)
@@ -177,7 +180,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--export") && i + 1 < argc)
       export_dir = argv[++i];
     else {
-      std::fprintf(stderr, "usage: bench_nets [--quick] [--sweep] [--threads N] [--export DIR]\n");
+      std::fprintf(stderr, "usage: bench_nets [--quick] [--sweep] [--light] [--threads N] [--export DIR]\n");
       return 2;
     }
   }
@@ -187,6 +190,17 @@ int main(int argc, char** argv) {
     return 0;
   }
   seed_torch(0);
+  if (light_only) {  // one line, for bench_light_vs_torch (the PyTorch peer's format)
+    NetConfig config;
+    config.architecture = Architecture::light;
+    config.base_channels = 16;
+    QAttentionNet depth0(config);
+    config.is_last = true;
+    QAttentionNet last(config);
+    const double t0 = train_step_seconds(depth0, 32, 5), t1 = train_step_seconds(last, 32, 5);
+    std::printf("ours light train step b32 (%d threads): depth 0 %.4f s, last depth %.4f s\n", threads, t0, t1);
+    return 0;
+  }
   std::printf("threads=%d, grid 16^3 x 10 channels, proprio 4 (arm also with the reference's 11)\n", threads);
   if (sweep || channels_last) {
     for (int k : {8, 16, 24, 32}) bench(Architecture::light, k, false, false, 4);
