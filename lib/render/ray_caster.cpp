@@ -45,7 +45,9 @@ void add_parts(const btCollisionObject& object, const btCollisionShape& shape,
   shape.getAabb(world_from_shape, low, high);
   const Eigen::Isometry3d pose = to_eigen(world_from_shape);
   parts.push_back({&object, &shape, pose, pose.inverse(),
-                   Eigen::AlignedBox3d(to_eigen(low), to_eigen(high))});
+                   Eigen::AlignedBox3d(to_eigen(low), to_eigen(high)), {}});
+  if (shape.getShapeType() == CONVEX_HULL_SHAPE_PROXYTYPE)
+    parts.back().planes = hull_planes(static_cast<const btConvexHullShape&>(shape));
 }
 
 // Whether the ray's first `length` metres pass through the box (slab test). A zero direction
@@ -63,7 +65,7 @@ bool ray_meets_box(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& start,
   return enter <= leave;
 }
 
-// Shapes without an exact test (convex hulls, meshes, planes) go to Bullet. Its GJK cast is
+// Shapes without an exact test (meshes, planes) go to Bullet. Its GJK cast is
 // far closer to the surface than the default subsimplex one (ray_shapes.hpp). Normal: world.
 bool bullet_ray_test(const ScenePart& part, const Eigen::Vector3d& start,
                      const Eigen::Vector3d& direction, double length, ShapeHit& hit) {
@@ -106,7 +108,12 @@ bool RayCaster::cast(const Eigen::Vector3d& start, const Eigen::Vector3d& direct
     // Only parts that could be closer than the closest hit so far.
     if (!ray_meets_box(part.bounds, start, inverse_direction, hit.distance)) continue;
     ShapeHit found;
-    if (is_primitive(*part.shape)) {
+    if (!part.planes.empty()) {
+      if (!intersect_planes(part.planes, part.shape_from_world * start, part.shape_from_world.linear() * direction,
+                            hit.distance, found))
+        continue;
+      found.normal = part.world_from_shape.linear() * found.normal;
+    } else if (is_primitive(*part.shape)) {
       if (!intersect_primitive(*part.shape, part.shape_from_world * start,
                                part.shape_from_world.linear() * direction, hit.distance, found))
         continue;

@@ -4,8 +4,9 @@
 // btDbvtBroadphase::rayTest walks its trees with one shared stack (m_rayTestStacks[0]), so
 // concurrent calls race; and its convex casts are approximate (see ray_shapes.hpp). Instead the
 // snapshot lists every object's primitive parts (compounds flattened) with their world AABBs;
-// each ray tests those boxes, then intersects the parts exactly. Shapes that are not
-// primitives go to btCollisionWorld::rayTestSingle, which keeps all its state in locals.
+// each ray tests those boxes, then intersects the parts exactly (primitives, and convex hulls
+// by their faces' planes). Other shapes go to btCollisionWorld::rayTestSingle, which keeps all
+// its state in locals.
 // Linear in the part count, which suits the tens of parts of a task scene.
 #pragma once
 
@@ -25,6 +26,7 @@ struct ScenePart {
   Eigen::Isometry3d world_from_shape;
   Eigen::Isometry3d shape_from_world;
   Eigen::AlignedBox3d bounds;  // world frame
+  std::vector<Eigen::Vector4d> planes;  // a convex hull's faces (ray_shapes.hpp), shape frame
 };
 
 struct RayHit {

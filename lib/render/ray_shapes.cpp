@@ -2,6 +2,9 @@
 
 #include <btBulletCollisionCommon.h>
 
+#include <Eigen/Geometry>
+
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -117,6 +120,69 @@ bool intersect_primitive(const btCollisionShape& shape, const Eigen::Vector3d& o
       return false;
   }
   return found && hit.distance <= max_distance;
+}
+
+std::vector<Eigen::Vector4d> hull_planes(const btConvexHullShape& hull) {
+  std::vector<Eigen::Vector3d> v;
+  for (int i = 0; i < hull.getNumPoints(); ++i) v.push_back(to_eigen(hull.getUnscaledPoints()[i]));
+  double size = 0;
+  for (const auto& p : v) size = std::max(size, (p - v.front()).norm());
+  const double tolerance = 1e-9 * std::max(size, 1e-3);
+  // Every plane through three vertices with all the vertices on one side is a face's.
+  std::vector<Eigen::Vector4d> planes;
+  const int n = static_cast<int>(v.size());
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j)
+      for (int k = j + 1; k < n; ++k) {
+        Eigen::Vector3d normal = (v[j] - v[i]).cross(v[k] - v[i]);
+        if (normal.norm() < tolerance * size) continue;  // (nearly) collinear
+        normal.normalize();
+        double offset = -normal.dot(v[i]);
+        bool in_front = false, behind = false;
+        for (const auto& p : v) {
+          const double d = normal.dot(p) + offset;
+          in_front |= d > tolerance;
+          behind |= d < -tolerance;
+        }
+        if (in_front && behind) continue;
+        if (in_front) normal = -normal, offset = -offset;  // outward: every vertex behind
+        const Eigen::Vector4d plane(normal.x(), normal.y(), normal.z(), offset);
+        const bool known = std::any_of(planes.begin(), planes.end(), [&](const Eigen::Vector4d& q) {
+          return (q - plane).cwiseAbs().maxCoeff() < 1e-9;
+        });
+        if (!known) planes.push_back(plane);
+      }
+  return planes;
+}
+
+bool intersect_planes(const std::vector<Eigen::Vector4d>& planes, const Eigen::Vector3d& origin,
+                      const Eigen::Vector3d& direction, double max_distance, ShapeHit& hit) {
+  // The ray inside every half-space at once: entering through the last plane it enters,
+  // before leaving through the first it leaves.
+  double enter = 0, leave = max_distance, last_entered = -std::numeric_limits<double>::infinity();
+  bool outside = false;
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector4d& plane : planes) {
+    const Eigen::Vector3d n = plane.head<3>();
+    const double height = n.dot(origin) + plane.w(), along = n.dot(direction);
+    outside |= height > 0;
+    if (along == 0) {
+      if (height > 0) return false;  // parallel, outside this face
+      continue;
+    }
+    const double t = -height / along;
+    if (along < 0) {
+      if (t > last_entered) last_entered = t, normal = n;
+      enter = std::max(enter, t);
+    } else {
+      leave = std::min(leave, t);
+    }
+    if (enter > leave) return false;
+  }
+  if (!outside) return false;  // starts inside: not seen, as with the primitives
+  hit.distance = enter;
+  hit.normal = normal;
+  return true;
 }
 
 }  // namespace qte::render

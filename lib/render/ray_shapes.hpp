@@ -1,5 +1,5 @@
-// Exact ray intersections with Bullet's primitive shapes (box, sphere, cylinder), in the
-// shape's own frame.
+// Exact ray intersections with Bullet's primitive shapes (box, sphere, cylinder) and convex
+// hulls (as the planes of their faces), in the shape's own frame.
 //
 // Why not Bullet's own: btCollisionWorld::rayTestSingle casts convex shapes with an iterative
 // convex cast that stops early. Against a 30 cm box seen at grazing angles the default
@@ -8,8 +8,10 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <vector>
 
 class btCollisionShape;
+class btConvexHullShape;
 
 namespace qte::render {
 
@@ -26,5 +28,14 @@ bool is_primitive(const btCollisionShape& shape);
 // A ray that starts inside the shape does not see it.
 bool intersect_primitive(const btCollisionShape& shape, const Eigen::Vector3d& origin,
                          const Eigen::Vector3d& direction, double max_distance, ShapeHit& hit);
+
+// The faces of a convex hull as planes n.x + d = 0 (n the outward unit normal, shape frame),
+// one per face however many of its vertices are coplanar: what a camera sees of it, sharp
+// edges included (Bullet's collision margin is left out, as the primitives' is).
+std::vector<Eigen::Vector4d> hull_planes(const btConvexHullShape& hull);
+
+// As intersect_primitive, for the convex polyhedron bounded by `planes`.
+bool intersect_planes(const std::vector<Eigen::Vector4d>& planes, const Eigen::Vector3d& origin,
+                      const Eigen::Vector3d& direction, double max_distance, ShapeHit& hit);
 
 }  // namespace qte::render

@@ -14,6 +14,7 @@ namespace qte::tasks {
 std::unique_ptr<Task> make_reach_target();
 std::unique_ptr<Task> make_pick_and_lift();
 std::unique_ptr<Task> make_lift_numbered_block();
+std::unique_ptr<Task> make_reach_prism();
 
 struct NamedColour {
   std::string name;

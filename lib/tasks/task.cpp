@@ -7,12 +7,15 @@
 
 namespace qte::tasks {
 
-std::vector<std::string> task_names() { return {"reach_target", "pick_and_lift", "lift_numbered_block"}; }
+std::vector<std::string> task_names() {
+  return {"reach_target", "pick_and_lift", "lift_numbered_block", "reach_prism"};
+}
 
 std::unique_ptr<Task> make_task(const std::string& name) {
   if (name == "reach_target") return make_reach_target();
   if (name == "pick_and_lift") return make_pick_and_lift();
   if (name == "lift_numbered_block") return make_lift_numbered_block();
+  if (name == "reach_prism") return make_reach_prism();
   std::string known;
   for (const auto& n : task_names()) known += (known.empty() ? "" : ", ") + n;
   throw Error("unknown task '" + name + "' (known tasks: " + known + ")");

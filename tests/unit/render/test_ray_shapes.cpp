@@ -1,4 +1,4 @@
-// Exact ray intersections with boxes, spheres and cylinders, and rays through compounds.
+// Exact ray intersections with boxes, spheres, cylinders and convex hulls, and rays through compounds.
 #include <btBulletCollisionCommon.h>
 #include <gtest/gtest.h>
 
@@ -23,10 +23,10 @@ double cylinder_excess(const Eigen::Vector3d& p, double r, double half_height) {
 
 // Random rays from outside towards the neighbourhood of the origin: the hit must be on the
 // surface, and the ray must stay outside up to it (it is the first hit).
-template <class Excess>
-void check_random_rays(const btCollisionShape& shape, Excess excess) {
+template <class Intersect, class Excess>
+void check_random_rays_of(Intersect intersect, Excess excess, double around_m = 0.15) {
   std::mt19937 random(7);
-  std::uniform_real_distribution<double> around(-0.15, 0.15);
+  std::uniform_real_distribution<double> around(-around_m, around_m);
   int hits = 0;
   for (int i = 0; i < 3000; ++i) {
     const Eigen::Vector3d origin = Eigen::Vector3d(around(random), around(random), around(random))
@@ -34,7 +34,7 @@ void check_random_rays(const btCollisionShape& shape, Excess excess) {
     const Eigen::Vector3d aim(around(random), around(random), around(random));
     const Eigen::Vector3d direction = (aim - origin).normalized();
     ShapeHit hit;
-    if (!intersect_primitive(shape, origin, direction, 2.0, hit)) {
+    if (!intersect(origin, direction, hit)) {
       for (double t = 0; t < 1.0; t += 0.001) ASSERT_GT(excess(origin + t * direction), -1e-7);
       continue;
     }
@@ -48,6 +48,26 @@ void check_random_rays(const btCollisionShape& shape, Excess excess) {
       ASSERT_GT(excess(origin + t * direction), -1e-7);
   }
   EXPECT_GT(hits, 300);
+}
+
+template <class Excess>
+void check_random_rays(const btCollisionShape& shape, Excess excess) {
+  check_random_rays_of([&](const Eigen::Vector3d& o, const Eigen::Vector3d& d,
+                           ShapeHit& hit) { return intersect_primitive(shape, o, d, 2.0, hit); },
+                       excess);
+}
+
+// A regular prism as a hull: `sides` vertices on a circle of radius r, height h, about z.
+btConvexHullShape regular_prism(int sides, double r, double h) {
+  btConvexHullShape hull;
+  for (double z : {-h / 2, h / 2})
+    for (int i = 0; i < sides; ++i)
+      hull.addPoint(btVector3(btScalar(r * std::cos(2 * M_PI * i / sides)), btScalar(r * std::sin(2 * M_PI * i / sides)),
+                              btScalar(z)),
+                    false);
+  hull.recalcLocalAabb();
+  hull.setMargin(0.001f);  // the simulator's: not drawn
+  return hull;
 }
 
 }  // namespace
@@ -134,28 +154,67 @@ TEST(RenderRayShapes, CompoundChildrenAreHitWhereTheyAre) {
   world.removeCollisionObject(&object);
 }
 
-TEST(RenderRayShapes, OtherShapesGoToBulletsRayTest) {
+// Convex hulls by the planes of their faces: a pentagonal prism against its own definition
+// (inside every edge's half-plane at the apothem, within the height), and a cube's corners
+// against the box primitive.
+TEST(RenderRayShapes, ConvexHullHitsAreOnTheSurface) {
+  const int sides = 5;
+  const double r = 0.02, h = 0.03;
+  const btConvexHullShape prism = regular_prism(sides, r, h);
+  const std::vector<Eigen::Vector4d> planes = hull_planes(prism);
+  EXPECT_EQ(planes.size(), static_cast<std::size_t>(sides + 2));  // one per face, however many triangles
+  const float rf = static_cast<float>(r), hf = static_cast<float>(h);  // the hull holds floats
+  const auto excess = [&](const Eigen::Vector3d& p) {
+    double e = std::abs(p.z()) - hf / 2;
+    for (int i = 0; i < sides; ++i) {
+      const double angle = 2 * M_PI * (i + 0.5) / sides;  // an edge's outward normal
+      e = std::max(e, p.x() * std::cos(angle) + p.y() * std::sin(angle) - rf * std::cos(M_PI / sides));
+    }
+    return e;
+  };
+  check_random_rays_of([&](const Eigen::Vector3d& o, const Eigen::Vector3d& d,
+                           ShapeHit& hit) { return intersect_planes(planes, o, d, 2.0, hit); },
+                       excess, 0.03);
+
+  btConvexHullShape cube;
+  for (int corner = 0; corner < 8; ++corner)
+    cube.addPoint(btVector3(corner & 1 ? 0.05f : -0.05f, corner & 2 ? 0.04f : -0.04f, corner & 4 ? 0.03f : -0.03f),
+                  false);
+  const std::vector<Eigen::Vector4d> faces = hull_planes(cube);
+  EXPECT_EQ(faces.size(), 6u);
+  check_random_rays_of([&](const Eigen::Vector3d& o, const Eigen::Vector3d& d,
+                           ShapeHit& hit) { return intersect_planes(faces, o, d, 2.0, hit); },
+                       [](const Eigen::Vector3d& p) { return box_excess(p, {0.05f, 0.04f, 0.03f}); });
+}
+
+TEST(RenderRayShapes, HullsInAWorldAreHitExactlyAndOtherShapesGoToBullet) {
   btDefaultCollisionConfiguration configuration;
   btCollisionDispatcher dispatcher(&configuration);
   btDbvtBroadphase broadphase;
   btCollisionWorld world(&dispatcher, &broadphase, &configuration);
-  btConvexHullShape hull;  // a 10 cm cube as a hull, with the simulator's 1 mm margin
-  for (int corner = 0; corner < 8; ++corner)
-    hull.addPoint(btVector3(corner & 1 ? 0.05f : -0.05f, corner & 2 ? 0.05f : -0.05f,
-                            corner & 4 ? 0.05f : -0.05f),
-                  false);
-  hull.recalcLocalAabb();
-  hull.setMargin(0.001f);
-  btCollisionObject object;
-  object.setCollisionShape(&hull);
-  world.addCollisionObject(&object);
+  btConvexHullShape hull = regular_prism(3, 0.05, 0.1);  // a triangular prism
+  btCapsuleShapeZ capsule(0.05f, 0.1f);                 // no exact test: Bullet's
+  btCollisionObject prism_object, capsule_object;
+  prism_object.setCollisionShape(&hull);
+  capsule_object.setCollisionShape(&capsule);
+  capsule_object.getWorldTransform().setOrigin(btVector3(0.5f, 0, 0));
+  world.addCollisionObject(&prism_object);
+  world.addCollisionObject(&capsule_object);
 
   const RayCaster caster(world);
   RayHit hit;
-  ASSERT_TRUE(caster.cast({0.01, 0.02, 1.0}, {0, 0, -1}, 2.0, hit));
-  EXPECT_NEAR(hit.distance, 1.0 - 0.05, 2e-3);  // the margin adds up to 1 mm
-  EXPECT_NEAR(hit.normal.z(), 1.0, 1e-3);
+  ASSERT_TRUE(caster.cast({0.01, 0.0, 1.0}, {0, 0, -1}, 2.0, hit));
+  EXPECT_NEAR(hit.distance, 1.0 - 0.05, 1e-7);  // the top face, exactly: no margin
+  EXPECT_NEAR(hit.normal.z(), 1.0, 1e-9);
   EXPECT_EQ(hit.part->shape, &hull);
+  // The slanted side facing -x: the edge midpoint is at x = -r cos(60 deg) = -0.025.
+  ASSERT_TRUE(caster.cast({-1.0, 0.0, 0.0}, {1, 0, 0}, 2.0, hit));
+  EXPECT_NEAR(hit.distance, 1.0 - 0.025, 1e-7);
+  EXPECT_NEAR(hit.normal.x(), -1.0, 1e-7);
   EXPECT_FALSE(caster.cast({0.2, 0.0, 1.0}, {0, 0, -1}, 2.0, hit));
-  world.removeCollisionObject(&object);
+  ASSERT_TRUE(caster.cast({0.5, 0.0, 1.0}, {0, 0, -1}, 2.0, hit));
+  EXPECT_NEAR(hit.distance, 1.0 - 0.1, 2e-3);  // the cap's top: radius + half height
+  EXPECT_EQ(hit.part->shape, &capsule);
+  world.removeCollisionObject(&prism_object);
+  world.removeCollisionObject(&capsule_object);
 }

@@ -88,7 +88,7 @@ TEST(Simulator, UnknownTaskIsAnErrorListingTheTasks) {
     run.send(reset_record("open_drawer", 0, 1));
     FAIL();
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("known tasks: reach_target, pick_and_lift, lift_numbered_block"),
+    EXPECT_NE(std::string(e.what()).find("known tasks: reach_target, pick_and_lift, lift_numbered_block, reach_prism"),
               std::string::npos);
     EXPECT_NE(std::string(e.what()).find("'reset' record, field 'task'"), std::string::npos) << e.what();
   }
@@ -225,7 +225,7 @@ class ExpertSolves : public ::testing::TestWithParam<std::string> {};
 TEST_P(ExpertSolves, SeveralSeeds) {
   for (int64_t seed = 0; seed < 5; ++seed) {
     SimRun run;
-    const int variation = static_cast<int>(seed % 3);
+    const int variation = static_cast<int>(seed % tasks::make_task(GetParam())->variation_count());
     const auto obs = run_expert(run, GetParam(), variation, seed);
     EXPECT_EQ(obs.scalar<uint8_t>("success"), 1)
         << GetParam() << " seed " << seed << (obs.has("failure") ? " failure " + obs.string("failure") : "");
@@ -235,7 +235,7 @@ TEST_P(ExpertSolves, SeveralSeeds) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Tasks, ExpertSolves,
-                         ::testing::Values("reach_target", "pick_and_lift", "lift_numbered_block"));
+                         ::testing::Values("reach_target", "pick_and_lift", "lift_numbered_block", "reach_prism"));
 
 // Demonstration, exploration and evaluation scenes never meet, for any run seed: with the
 // seeds examples/learn.sh gives (demo-record --seed S, sim-step --seed S * 100000 + chunk

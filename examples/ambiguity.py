@@ -1,0 +1,84 @@
+#!/usr/bin/env python3
+"""What makes a task coarsely ambiguous, by numbers: the objects on the table in the first
+observation of a demonstration, the target being the one the expert's last pose is over.
+
+    ambiguity.py centres DEMO.rec               one line per object, x,y,z (target first)
+    ambiguity.py compare VOXELS.rec             after voxelize --centre <each of them>: the
+                                                depth-0 voxel of each object (its 10 channels)
+                                                and the top view of its depth-1 grid
+
+Objects are the points 3 mm to 10 cm above the table top inside the task region, grouped by
+distance (5 cm); the table top is at 0.752 m (DESIGN's layout). Run with Debian's python3."""
+import sys
+
+import numpy as np
+
+from read_stream import read_records
+
+TABLE_Z, REGION = 0.752, ((-0.05, 0.35), (-0.3, 0.3))
+
+
+def objects(obs):
+    points = np.asarray(obs.fields["front.points"]).reshape(-1, 3)
+    points = points[np.isfinite(points).all(1)]
+    keep = ((points[:, 2] > TABLE_Z + 0.003) & (points[:, 2] < TABLE_Z + 0.1) &
+            (points[:, 0] > REGION[0][0]) & (points[:, 0] < REGION[0][1]) &
+            (np.abs(points[:, 1]) < REGION[1][1]))
+    groups = []  # [sum, count]
+    for p in points[keep]:
+        for g in groups:
+            if np.linalg.norm(g[0] / g[1] - p) < 0.05:
+                g[0] += p
+                g[1] += 1
+                break
+        else:
+            groups.append([p.astype(np.float64).copy(), 1])
+    return [g[0] / g[1] for g in groups if g[1] >= 10]
+
+
+def centres(path):
+    records = [r for r in read_records(path) if r.type == "obs"]
+    found = objects(records[0])
+    last = np.asarray(records[-1].fields["gripper_pose"])[:2]
+    found.sort(key=lambda c: np.linalg.norm(c[:2] - last))  # the target first
+    for c in found:
+        print(f"{c[0]:.4f},{c[1]:.4f},{c[2]:.4f}")
+
+
+def compare(path):
+    voxels = next(r for r in read_records(path) if r.type == "voxels")
+    coarse, coarse_bounds = np.asarray(voxels.fields["depth0.grid"]), np.asarray(voxels.fields["depth0.bounds"])
+    fine, fine_bounds = np.asarray(voxels.fields["depth1.grid"]), np.asarray(voxels.fields["depth1.bounds"])
+    n = coarse.shape[0]
+    names = ["target"] + [f"distractor {i}" for i in range(1, fine.shape[0])]
+    print("depth 0 (%.2f cm voxels): each object's voxel, channels mean x y z | r g b | index x y z | occupied"
+          % (100 * coarse_bounds[3] / n))
+    for k, name in enumerate(names):
+        centre = fine_bounds[k][:3] + fine_bounds[k][3] / 2
+        index = np.floor((centre - coarse_bounds[:3]) / coarse_bounds[3] * n).astype(int)
+        c = coarse[tuple(index)]
+        print(f"  {name:13s} voxel {tuple(index)}: " + " ".join(f"{v:+.3f}" for v in c))
+    print("depth 1 (%.2f cm voxels): top view of each object's grid (# occupied in some layer above the table)"
+          % (100 * fine_bounds[0][3] / n))
+    views = []
+    for k in range(fine.shape[0]):
+        occupied = fine[k, ..., 9] > 0
+        z0 = int(np.floor((TABLE_Z + 0.003 - fine_bounds[k][2]) / fine_bounds[k][3] * n)) + 1
+        views.append(occupied[4:12, 4:12, max(z0, 0):].any(axis=2))
+    for row in range(8):
+        print("  " + "   ".join("".join("#" if v[row, col] else "." for col in range(8)) for v in views))
+    print("  " + "   ".join(f"{name[:8]:8s}" for name in names))
+    for k, name in enumerate(names):
+        above = fine[k, ..., 9] > 0
+        above[..., :max(int(np.floor((TABLE_Z + 0.003 - fine_bounds[k][2]) / fine_bounds[k][3] * n)) + 1, 0)] = False
+        means = fine[k][above][:, :3]
+        extent = 100 * (means.max(0) - means.min(0)) if len(means) else np.zeros(3)
+        cells = ", ".join(f"{v:d}" for v in np.bincount(np.nonzero(above)[2])[np.bincount(np.nonzero(above)[2]) > 0])
+        print(f"  {name:13s} {int(above.sum()):2d} occupied voxels above the table (per layer: {cells}); "
+              f"their points' mean positions span {extent[0]:.1f} x {extent[1]:.1f} x {extent[2]:.1f} cm")
+    for k in range(1, len(views)):
+        print(f"  target vs {names[k]}: {np.sum(views[0] != views[k])} of 64 top-view cells differ")
+
+
+if __name__ == "__main__":
+    {"centres": centres, "compare": compare}[sys.argv[1]](sys.argv[2])

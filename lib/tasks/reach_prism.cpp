@@ -1,0 +1,74 @@
+// reach_prism: three small yellow objects of one height on the table, a pentagonal prism, a
+// triangular prism and a cube; bring the gripper to the pentagonal prism (the paper's
+// real-world task, simulated). Each footprint fits one 6.25 cm voxel of depth 0 and spans
+// several 1.9 cm voxels of depth 1: only the finer depth tells the shapes apart.
+#include <cmath>
+
+#include "tasks/catalogue.hpp"
+
+namespace qte::tasks {
+namespace {
+
+constexpr double kHeight = 0.03;
+constexpr double kReachAbove = 0.02;   // the reach point: this far above the prism's top face
+constexpr double kReachRadius = 0.025;  // success: the TCP within this of the reach point
+
+// A regular prism standing on the table: `sides` vertices on a circle of `radius` (object frame,
+// z up, centred), yawed by `yaw_rad`.
+sim::ObjectSpec regular_prism(const sim::World& world, const std::string& name, int sides, double radius,
+                              const Eigen::Vector3d& xy, double yaw_rad) {
+  sim::ObjectSpec spec;
+  spec.name = name;
+  spec.shape = sim::ObjectSpec::Shape::convex_hull;
+  for (double z : {-kHeight / 2, kHeight / 2})
+    for (int i = 0; i < sides; ++i) {
+      const double angle = 2 * M_PI * i / sides;
+      spec.hull_points.emplace_back(radius * std::cos(angle), radius * std::sin(angle), z);
+    }
+  spec.pose.linear() = Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  spec.pose.translation() << xy.x(), xy.y(), world.layout().table_height_m + kHeight / 2;
+  spec.mass_kg = 0;  // fixed where placed: reaching does not move it
+  spec.graspable = false;
+  spec.appearance.colour = Eigen::Vector3f(0.95f, 0.8f, 0.1f);
+  return spec;
+}
+
+class ReachPrism : public Task {
+ public:
+  std::string name() const override { return "reach_prism"; }
+  int variation_count() const override { return 1; }
+  std::string description(int) const override { return "reach the pentagonal prism"; }
+
+  void build(sim::World& world, int, std::mt19937_64& rng) override {
+    const auto positions = sample_separated(rng, 3, {kRegionMinX, kRegionMinY, 0}, {kRegionMaxX, kRegionMaxY, 0}, 0.1);
+    std::uniform_real_distribution<double> yaw(-M_PI, M_PI);
+    // Footprints 4.0-4.3 cm across: the pentagon's 2.1 cm circumradius, the triangle's 2.5 cm
+    // (4.3 cm sides), the cube's 3 cm sides (4.2 cm diagonal).
+    world.add_object(regular_prism(world, "prism", 5, 0.021, positions[0], yaw(rng)));
+    world.add_object(regular_prism(world, "triangular_prism", 3, 0.025, positions[1], yaw(rng)));
+    world.add_object(regular_prism(world, "cube", 4, 0.03 / std::sqrt(2.0), positions[2], yaw(rng)));
+  }
+
+  bool success(const sim::World& world) const override {
+    return (world.tcp_pose().translation() - reach_point(world)).norm() <= kReachRadius;
+  }
+
+  std::vector<Waypoint> expert_waypoints(const sim::World& world) const override {
+    Waypoint reach;
+    reach.tcp_pose.linear() = top_down(0);
+    reach.tcp_pose.translation() = reach_point(world);
+    return {reach};
+  }
+
+ private:
+  static Eigen::Vector3d reach_point(const sim::World& world) {
+    return world.object_pose(world.object_id("prism")).translation() +
+           Eigen::Vector3d(0, 0, kHeight / 2 + kReachAbove);
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<Task> make_reach_prism() { return std::make_unique<ReachPrism>(); }
+
+}  // namespace qte::tasks
