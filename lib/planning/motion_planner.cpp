@@ -86,6 +86,8 @@ OccupancyScene MotionPlanner::scene_from(const stream::Record& obs, const StartS
     const auto points = obs.array<float>(camera + ".points");
     const auto extrinsics = obs.array<double>(camera + ".extrinsics");
     if (extrinsics.size() != 16) obs.fail(camera + ".extrinsics", "float64 [4, 4]");
+    for (std::size_t i = 0; i < 16; ++i)
+      if (!std::isfinite(extrinsics[i])) obs.fail(camera + ".extrinsics", "finite float64 [4, 4] (the camera pose)");
     if (points.shape.size() != 3 || points.shape[2] != 3) obs.fail(camera + ".points", "float32 [H, W, 3]");
     const Eigen::Vector3d origin(extrinsics[3], extrinsics[7], extrinsics[11]);
     scene.insert_camera(points.data, static_cast<std::size_t>(points.size() / 3), origin, robot_now, free_regions);

@@ -2,7 +2,12 @@
 
 #include <octomap/OcTree.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cstdio>
+#include <iostream>
 #include <climits>
 #include <cmath>
 #include <sstream>
@@ -236,8 +241,23 @@ std::vector<Eigen::Vector3d> OccupancyScene::occupied_voxel_centres() const {
 
 void OccupancyScene::write_binary(const std::string& path) const {
   // writeBinaryConst: the same format as writeBinary, without thresholding our own tree.
+  const octomap::OcTree& map = impl_->map();
   std::ostringstream bytes;
-  if (!impl_->map().writeBinaryConst(bytes)) throw Error(path + ": could not serialise the octree");
+  bool written = false;
+  {
+    // Debian's OctoMap reports " done." on standard error after serialising; what a program
+    // prints there is its own one-line errors.
+    std::fflush(stderr);
+    std::cerr.flush();
+    const int saved = ::dup(STDERR_FILENO), null = ::open("/dev/null", O_WRONLY);
+    if (saved >= 0 && null >= 0) ::dup2(null, STDERR_FILENO);
+    written = map.writeBinaryConst(bytes);
+    std::fflush(stderr);
+    std::cerr.flush();
+    if (saved >= 0) ::dup2(saved, STDERR_FILENO), ::close(saved);
+    if (null >= 0) ::close(null);
+  }
+  if (!written) throw Error(path + ": could not serialise the octree");
   const std::string data = bytes.str();
   write_file_atomically(path, data.data(), data.size());
 }

@@ -6,7 +6,9 @@ stream-pack reset task=pick_and_lift seed:i64=2 > "$tmp/reset.rec"
 sim-step < "$tmp/reset.rec" > "$tmp/obs.rec" || fail "sim-step"
 # 40 cm above the table, gripper pointing down (180 deg about x: qx = 1).
 stream-pack action pose:f64=0.1,0.0,1.15,1,0,0,0 gripper_open:u8=1 > "$tmp/action.rec"
-cat "$tmp/obs.rec" "$tmp/action.rec" | plan-path --seed 3 --octomap "$tmp/scene.bt" > "$tmp/planned.rec" || fail "plan-path exit"
+cat "$tmp/obs.rec" "$tmp/action.rec" | plan-path --seed 3 --octomap "$tmp/scene.bt" > "$tmp/planned.rec" 2> "$tmp/err" \
+  || fail "plan-path exit"
+[ ! -s "$tmp/err" ] || fail "plan-path --octomap printed on standard error: $(cat "$tmp/err")"  # OctoMap's " done."
 [ "$(stream-dump --summary "$tmp/planned.rec" | cut -f1,2 | tr '\n' ' ')" = "$(printf 'action\t1 records obs\t1 records trajectory\t1 records ')" ] \
   || fail "expected obs, action and trajectory to come out: $(stream-dump --summary "$tmp/planned.rec")"
 stream-dump --json --type trajectory "$tmp/planned.rec" | grep -q '"name":"joint_positions","dtype":"float64","shape":\[[0-9]*,7\]' \

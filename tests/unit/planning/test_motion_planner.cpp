@@ -171,6 +171,20 @@ TEST(MotionPlanner, ActionRecordsAreValidated) {
   obs.set_scalar<uint8_t>("gripper_open", 1);
   MotionPlanner planner(xarm(), sim::SceneLayout{}.robot_base_pose());
   EXPECT_THROW(planner.scene_from(obs, start_state_from(obs)), StreamError);  // no point cloud
+
+  // A camera pose with a NaN: an error naming the field, not a scene seen from nowhere.
+  Scene scene("reach_target", 1);
+  std::vector<double> extrinsics(scene.obs.array<double>("front.extrinsics").begin(),
+                                 scene.obs.array<double>("front.extrinsics").end());
+  extrinsics[7] = NAN;
+  scene.obs.set<double>("front.extrinsics", {4, 4}, extrinsics);
+  try {
+    planner.scene_from(scene.obs, start_state_from(scene.obs));
+    FAIL() << "NaN extrinsics accepted";
+  } catch (const StreamError& e) {
+    EXPECT_NE(std::string(e.what()).find("front.extrinsics"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("finite"), std::string::npos) << e.what();
+  }
 }
 
 TEST(MotionPlanner, SameSeedSamePlan) {
