@@ -80,8 +80,7 @@ evaluate() {  # CHECKPOINT ENV_STEPS OUT.csv LEARNER_STEP EVAL_POINT
   mv "$3.tmp" "$3"
 }
 
-# One chunk of exploring episodes through the closed loop -> chunks/NNNN.rec and its step
-# count in chunks/NNNN.steps.
+# One chunk of exploring episodes through the closed loop -> chunks/NNNN.rec.
 run_chunk() {  # CHUNK
   local name fifo seed
   name=$run/chunks/$(printf '%04d' "$1") seed=$((SEED * 100000 + $1))
@@ -96,10 +95,9 @@ run_chunk() {  # CHUNK
     return 1
   fi
   rm -f "$fifo"
-  stream-dump --summary "$name.partial" | awk '$1 == "action" { print $2 }' > "$name.steps"
   mv "$name.partial" "$name.rec"
 }
-# Environment steps of the finished chunks (counted once per chunk).
+# Environment steps of the finished chunks (each counted once, into chunks/NNNN.steps).
 finished_steps() {
   local f n=0
   for f in "$run"/chunks/*.rec; do

@@ -164,13 +164,10 @@ void OccupancyScene::insert_camera(const float* points_xyz, std::size_t count, c
   // The endpoints' voxels, as OctoMap's discretised insertion takes them: the voxel of each
   // point, kept when its centre lies in the box.
   Impl& m = *impl_;
-  std::vector<octomap::OcTreeKey> keys;
-  keys.reserve(cloud.size());
   for (const octomap::point3d& p : cloud) {
     const octomap::OcTreeKey key = m.tree.coordToKey(p);
-    if (m.tree.inBBX(m.tree.keyToCoord(key))) keys.push_back(key);
+    if (m.tree.inBBX(m.tree.keyToCoord(key))) m.endpoint_keys.push_back(key);
   }
-  m.endpoint_keys.insert(m.endpoint_keys.end(), keys.begin(), keys.end());
   m.scans.push_back({std::move(cloud), octomap::point3d(sensor_origin.x(), sensor_origin.y(), sensor_origin.z())});
   m.tree_current = false;
   m.built = false;  // stale now
