@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """What makes a task coarsely ambiguous, by numbers: the objects on the table in the first
-observation of a demonstration, the target being the one the expert's last pose is over.
+observation of a demonstration, the target being the one the expert first closes the gripper
+over (or, if it never does, the one its last pose is over).
 
     ambiguity.py centres DEMO.rec               one line per object, x,y,z (target first)
     ambiguity.py compare VOXELS.rec             after voxelize --centre <each of them>: the
@@ -39,8 +40,9 @@ def objects(obs):
 def centres(path):
     records = [r for r in read_records(path) if r.type == "obs"]
     found = objects(records[0])
-    last = np.asarray(records[-1].fields["gripper_pose"])[:2]
-    found.sort(key=lambda c: np.linalg.norm(c[:2] - last))  # the target first
+    closed = [r for r in records if not int(np.asarray(r.fields["gripper_open"]).reshape(-1)[0])]
+    over = np.asarray((closed or records[-1:])[0].fields["gripper_pose"])[:2]
+    found.sort(key=lambda c: np.linalg.norm(c[:2] - over))  # the target first
     for c in found:
         print(f"{c[0]:.4f},{c[1]:.4f},{c[2]:.4f}")
 
@@ -69,11 +71,15 @@ def compare(path):
         print("  " + "   ".join("".join("#" if v[row, col] else "." for col in range(8)) for v in views))
     print("  " + "   ".join(f"{name[:8]:8s}" for name in names))
     for k, name in enumerate(names):
-        above = fine[k, ..., 9] > 0
-        above[..., :max(int(np.floor((TABLE_Z + 0.003 - fine_bounds[k][2]) / fine_bounds[k][3] * n)) + 1, 0)] = False
+        # Occupied voxels above the table in the grid's middle 4 x 4 columns (7.5 cm square: the
+        # object's, which the grid is centred on; neighbours are 10 cm away).
+        above = np.zeros(fine.shape[1:4], bool)
+        z0 = max(int(np.floor((TABLE_Z + 0.003 - fine_bounds[k][2]) / fine_bounds[k][3] * n)) + 1, 0)
+        above[6:10, 6:10, z0:] = fine[k, 6:10, 6:10, z0:, 9] > 0
         means = fine[k][above][:, :3]
         extent = 100 * (means.max(0) - means.min(0)) if len(means) else np.zeros(3)
-        cells = ", ".join(f"{v:d}" for v in np.bincount(np.nonzero(above)[2])[np.bincount(np.nonzero(above)[2]) > 0])
+        layers = np.bincount(np.nonzero(above)[2])
+        cells = ", ".join(f"{v:d}" for v in layers[layers > 0])
         print(f"  {name:13s} {int(above.sum()):2d} occupied voxels above the table (per layer: {cells}); "
               f"their points' mean positions span {extent[0]:.1f} x {extent[1]:.1f} x {extent[2]:.1f} cm")
     for k in range(1, len(views)):

@@ -33,9 +33,39 @@ task=$1 run=$2
 : "${ENV_STEPS:=2000}" "${CHUNK_EPISODES:=10}" "${EVAL_EVERY:=250}" "${EVAL_EPISODES:=50}" "${EVAL_SEED:=1000000}"
 : "${ARCH:=light}" "${BATCH:=32}" "${RATIO:=0.5}" "${PRETRAIN:=200}" "${START_AFTER:=0}"
 : "${LEARNER_THREADS:=1}" "${EPSILON:=0.1}" "${ROTATION_NOISE:=1}" "${CHECKPOINT_EVERY:=25}" "${LABEL:=k$ACT_K-$TARGET_K}"
-: "${N_STEP:=1}" "${ACTORS:=1}"
+: "${N_STEP:=1}" "${ACTORS:=1}" "${CPU_BUDGET:=0}"
 mkdir -p "$run/chunks" "$run/eval"
 log() { printf '%s %s\n' "$(date +%H:%M:%S)" "$*" >&2; }
+# The time a run spends training, up to each evaluation and summed over resumptions
+# (evaluations excluded; an interrupted chunk's time is not counted: the chunk is run again):
+# train_s, wall-clock seconds, and cpu_s, the processor seconds of the run's own processes
+# (the learner, the actors, the demonstrations), which other work on the machine leaves alone.
+clock=$(date +%s) ticks=$(getconf CLK_TCK) eval_ticks=0
+cpu_base=$(cat "$run/cpu_seconds" 2>/dev/null || echo 0)
+stat_ticks() {  # PID FIELD... : the sum of those fields of /proc/PID/stat (0 once it is gone)
+  local stat fields n=0 i
+  stat=$(cat "/proc/$1/stat" 2>/dev/null) || { echo 0; return; }
+  read -ra fields <<< "${stat##*) }"  # from field 3 on: the command name may hold spaces
+  shift
+  for i in "$@"; do n=$(( n + fields[i - 3] )); done
+  echo "$n"
+}
+# Learner (utime + stime) and finished children of this shell (cutime + cstime).
+run_ticks() { echo $(( $(stat_ticks "$learner" 14 15) + $(stat_ticks $$ 16 17) - eval_ticks )); }
+cpu_seconds() { echo $(( cpu_base + $(run_ticks) / ticks )); }
+count_training_time() {
+  local now; now=$(date +%s)
+  echo $(( $(cat "$run/train_seconds" 2>/dev/null || echo 0) + now - clock )) > "$run/train_seconds.tmp"
+  mv "$run/train_seconds.tmp" "$run/train_seconds"
+  cpu_seconds > "$run/cpu_seconds.tmp"
+  mv "$run/cpu_seconds.tmp" "$run/cpu_seconds"
+  clock=$now
+}
+# CPU_BUDGET > 0: a budget in processor seconds as well (1200: the paper's "10 minutes",
+# on 2 cores): once it is spent no chunk starts, and the final evaluation takes the learner's
+# newest checkpoint as it stands (the learner is not waited for: its speed is part of what
+# the budget measures).
+out_of_budget() { [ "$CPU_BUDGET" -gt 0 ] && [ "$(cpu_seconds)" -ge "$CPU_BUDGET" ]; }
 
 # 1. Demonstrations -> transitions (once; written under a temporary name, then renamed).
 if [ ! -f "$run/replay.rec" ]; then
@@ -74,7 +104,7 @@ evaluate() {  # CHECKPOINT ENV_STEPS OUT.csv LEARNER_STEP EVAL_POINT
     | qte-select --checkpoint "$1" --k "$ACT_K" --threads 1 \
     | plan-path | tee "$fifo" \
     | episode-stats --label "$LABEL" --column seed="$SEED" --column env_steps="$2" --column train_step="$4" \
-        --column eval_point="$5" \
+        --column eval_point="$5" --column train_s="$(cat "$run/train_seconds")" --column cpu_s="$(cat "$run/cpu_seconds")" \
         > "$3.tmp"
   rm -f "$fifo"
   mv "$3.tmp" "$3"
@@ -111,18 +141,26 @@ finished_steps() {
 declare -A failures=()
 while :; do
   env_steps=$(finished_steps)
+  finished=0
+  if [ "$env_steps" -ge "$ENV_STEPS" ]; then finished=1; elif out_of_budget; then finished=2; fi
   # Every EVAL_EVERY environment steps and at the end: evaluate what the learner has made of
   # the experience so far, once it has taken the steps the replay ratio allows.
-  mark=$(( env_steps >= ENV_STEPS ? 999999 : env_steps / EVAL_EVERY ))
+  mark=$(( finished ? 999999 : env_steps / EVAL_EVERY ))
   eval_csv=$run/eval/$(printf '%06d' "$mark").csv
   if [ ! -f "$eval_csv" ]; then
-    wait_for_learner "$env_steps"
+    [ "$finished" = 2 ] || wait_for_learner "$env_steps"
     snapshot=$run/eval/checkpoint.rec
     until step=$(learner_step) && cp "$run/ckpt/step-$(printf '%08d' "$step").rec" "$snapshot" 2>/dev/null; do sleep 0.2; done
-    evaluate "$snapshot" "$env_steps" "$eval_csv" "$step" $(( mark == 999999 ? ENV_STEPS : mark * EVAL_EVERY ))
+    count_training_time
+    # eval_point: the budget the evaluation stands for; out of budget, the steps it bought.
+    point=$(( finished == 2 ? env_steps : finished ? ENV_STEPS : mark * EVAL_EVERY ))
+    before=$(stat_ticks $$ 16 17)
+    evaluate "$snapshot" "$env_steps" "$eval_csv" "$step" "$point"
+    eval_ticks=$(( eval_ticks + $(stat_ticks $$ 16 17) - before ))
+    clock=$(date +%s)
     log "$task $LABEL seed $SEED: env steps $env_steps, learner step $step: $(tail -1 "$eval_csv")"
   fi
-  [ "$env_steps" -ge "$ENV_STEPS" ] && break
+  [ "$finished" = 0 ] || break
 
   # One round: the next ACTORS chunks not yet finished, side by side.
   round=() chunk=0

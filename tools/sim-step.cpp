@@ -32,7 +32,8 @@ static cli::Usage usage() {
       "winds down without broken pipes.",
       "Cameras are rendered without a GPU, one ray per pixel against Bullet's collision world, "
       "with per-object colours, diffuse shading and textures (the digits of "
-      "lift_numbered_block). Tasks: reach_target, pick_and_lift, lift_numbered_block, reach_prism.",
+      "lift_numbered_block). Tasks: reach_target, pick_and_lift, lift_numbered_block, reach_prism, "
+      "pick_and_lift_small.",
   };
   u.arguments = {{"FILE", "input records; '-' or absent is standard input", true, false}};
   u.options = {

@@ -24,7 +24,18 @@ Eigen::Isometry3d from_bullet(const btTransform& t) {
   return pose;
 }
 
-std::unique_ptr<btCollisionShape> make_shape(const ObjectSpec& spec) {
+std::unique_ptr<btConvexHullShape> make_hull(const std::vector<Eigen::Vector3d>& points) {
+  auto hull = std::make_unique<btConvexHullShape>();
+  for (const auto& p : points) hull->addPoint(btVector3(p.x(), p.y(), p.z()), false);
+  hull->setMargin(0.001);
+  hull->recalcLocalAabb();  // after the margin: the cached box includes it (default 4 cm)
+  return hull;
+}
+
+// The object's collision shape; a compound's pieces go to `children` (the compound only
+// points at them).
+std::unique_ptr<btCollisionShape> make_shape(const ObjectSpec& spec,
+                                             std::vector<std::unique_ptr<btCollisionShape>>& children) {
   const Eigen::Vector3d& s = spec.size;
   switch (spec.shape) {
     case ObjectSpec::Shape::box:
@@ -33,12 +44,16 @@ std::unique_ptr<btCollisionShape> make_shape(const ObjectSpec& spec) {
       return std::make_unique<btCylinderShapeZ>(btVector3(s.x(), s.x(), s.y() / 2));
     case ObjectSpec::Shape::sphere:
       return std::make_unique<btSphereShape>(s.x());
-    case ObjectSpec::Shape::convex_hull: {
-      auto hull = std::make_unique<btConvexHullShape>();
-      for (const auto& p : spec.hull_points) hull->addPoint(btVector3(p.x(), p.y(), p.z()), false);
-      hull->recalcLocalAabb();
-      hull->setMargin(0.001);
-      return hull;
+    case ObjectSpec::Shape::convex_hull:
+      return make_hull(spec.hull_points);
+    case ObjectSpec::Shape::compound: {
+      if (spec.pieces.empty()) throw Error("compound object '" + spec.name + "' has no pieces");
+      auto compound = std::make_unique<btCompoundShape>();
+      for (const auto& piece : spec.pieces) {
+        children.push_back(make_hull(piece));
+        compound->addChildShape(btTransform::getIdentity(), children.back().get());
+      }
+      return compound;
     }
   }
   throw Error("unknown object shape");
@@ -167,7 +182,10 @@ int World::add_object(const ObjectSpec& spec) {
   if (spec.name.empty()) throw Error("an object needs a name");
   for (const auto& s : impl_->specs)
     if (s.name == spec.name) throw Error("two objects named '" + spec.name + "'");
-  Impl::Body body = impl_->make_body(make_shape(spec), spec.mass_kg, to_bullet(spec.pose), spec.appearance);
+  std::vector<std::unique_ptr<btCollisionShape>> children;
+  auto shape = make_shape(spec, children);
+  Impl::Body body = impl_->make_body(std::move(shape), spec.mass_kg, to_bullet(spec.pose), spec.appearance);
+  body.children = std::move(children);
   if (!spec.collides)
     body.body->setCollisionFlags(body.body->getCollisionFlags() | btCollisionObject::CF_NO_CONTACT_RESPONSE);
   impl_->world.addRigidBody(body.body.get());

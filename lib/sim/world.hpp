@@ -17,12 +17,15 @@ class btCollisionWorld;
 namespace qte::sim {
 
 struct ObjectSpec {
-  enum class Shape { box, cylinder, sphere, convex_hull };
+  enum class Shape { box, cylinder, sphere, convex_hull, compound };
   std::string name;
   Shape shape = Shape::box;
   Eigen::Vector3d size = Eigen::Vector3d::Constant(0.05);  // box: extents; cylinder: (radius,
                                                            // height, -); sphere: (radius, -, -)
   std::vector<Eigen::Vector3d> hull_points;  // convex_hull: vertices in the object frame
+  // compound: a non-convex object as the union of convex hulls (vertices in the object frame),
+  // as Bullet collides it and the cameras see it.
+  std::vector<std::vector<Eigen::Vector3d>> pieces;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   double mass_kg = 0.1;     // 0: static (never moves)
   bool collides = true;     // false: seen by cameras only (e.g. a success zone)

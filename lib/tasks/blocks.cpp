@@ -35,4 +35,31 @@ std::vector<Waypoint> grasp_and_lift(const sim::World& world, int block_id, doub
   return {above, grasp, lift};
 }
 
+sim::ObjectSpec success_zone(const sim::World& world, const Eigen::Vector3d& xy, double radius) {
+  sim::ObjectSpec zone;
+  zone.name = "success_zone";
+  zone.shape = sim::ObjectSpec::Shape::sphere;
+  zone.size = Eigen::Vector3d(radius, 0, 0);
+  zone.pose.translation() << xy.x(), xy.y(), world.layout().table_height_m + 0.3;
+  zone.mass_kg = 0;
+  zone.collides = false;
+  zone.graspable = false;
+  zone.appearance.colour = Eigen::Vector3f(0.55f, 0.95f, 0.55f);
+  return zone;
+}
+
+std::vector<Waypoint> lift_into_zone(const sim::World& world, int object_id) {
+  auto waypoints = grasp_and_lift(world, object_id, 0.15);
+  Waypoint into_zone = waypoints.back();
+  into_zone.tcp_pose.translation() = world.object_pose(world.object_id("success_zone")).translation();
+  into_zone.ignore_collisions = false;
+  waypoints.push_back(into_zone);
+  return waypoints;
+}
+
+bool held_in_zone(const sim::World& world, int object_id, double radius) {
+  const Eigen::Vector3d zone = world.object_pose(world.object_id("success_zone")).translation();
+  return world.held_object() == object_id && (world.object_pose(object_id).translation() - zone).norm() <= radius;
+}
+
 }  // namespace qte::tasks

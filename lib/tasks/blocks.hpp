@@ -1,4 +1,5 @@
-// Blocks on the table and the top-down grasp of one, shared by the block tasks.
+// Blocks on the table, the top-down grasp of an object and the success zone it is lifted into:
+// what the pick tasks share.
 #pragma once
 
 #include "tasks/catalogue.hpp"
@@ -14,5 +15,12 @@ sim::ObjectSpec block(const sim::World& world, const std::string& name, const Ei
 // Pre-grasp above the block, grasp at its centre (gripper closes), then lift straight up by
 // `lift_m`: the first three waypoints of every pick task.
 std::vector<Waypoint> grasp_and_lift(const sim::World& world, int block_id, double lift_m);
+
+// The green sphere an object is lifted into, 0.3 m above the table at (x, y); seen, not felt.
+sim::ObjectSpec success_zone(const sim::World& world, const Eigen::Vector3d& xy, double radius);
+// grasp_and_lift by 15 cm, then into the scene's "success_zone".
+std::vector<Waypoint> lift_into_zone(const sim::World& world, int object_id);
+// The object is held and its centre inside the scene's "success_zone" of `radius`.
+bool held_in_zone(const sim::World& world, int object_id, double radius);
 
 }  // namespace qte::tasks

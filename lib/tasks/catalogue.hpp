@@ -15,6 +15,7 @@ std::unique_ptr<Task> make_reach_target();
 std::unique_ptr<Task> make_pick_and_lift();
 std::unique_ptr<Task> make_lift_numbered_block();
 std::unique_ptr<Task> make_reach_prism();
+std::unique_ptr<Task> make_pick_and_lift_small();
 
 struct NamedColour {
   std::string name;
@@ -26,6 +27,9 @@ const std::vector<NamedColour>& colours();
 std::vector<Eigen::Vector3d> sample_separated(std::mt19937_64& rng, int count,
                                               const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
                                               double min_distance_m);
+// A point uniform in the box [lo, hi] at least `min_distance_m` from each of `others`.
+Eigen::Vector3d sample_away_from(std::mt19937_64& rng, const std::vector<Eigen::Vector3d>& others,
+                                 const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double min_distance_m);
 // `count` distinct integers in [0, range), none equal to `excluded`.
 std::vector<int> pick_distinct(std::mt19937_64& rng, int count, int range, int excluded);
 

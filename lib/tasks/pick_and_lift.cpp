@@ -26,32 +26,15 @@ class PickAndLift : public Task {
     for (int i = 0; i < 2; ++i)
       world.add_object(block(world, "distractor" + std::to_string(i + 1), positions[i + 1], yaw(rng),
                              colours()[distractors[i]].rgb));
-    sim::ObjectSpec zone;
-    zone.name = "success_zone";
-    zone.shape = sim::ObjectSpec::Shape::sphere;
-    zone.size = Eigen::Vector3d(kZoneRadius, 0, 0);
-    zone.pose.translation() << positions[3].x(), positions[3].y(), world.layout().table_height_m + 0.3;
-    zone.mass_kg = 0;
-    zone.collides = false;
-    zone.graspable = false;
-    zone.appearance.colour = Eigen::Vector3f(0.55f, 0.95f, 0.55f);
-    world.add_object(zone);
+    world.add_object(success_zone(world, positions[3], kZoneRadius));
   }
 
   bool success(const sim::World& world) const override {
-    const int target = world.object_id("target");
-    const Eigen::Vector3d zone = world.object_pose(world.object_id("success_zone")).translation();
-    return world.held_object() == target &&
-           (world.object_pose(target).translation() - zone).norm() <= kZoneRadius;
+    return held_in_zone(world, world.object_id("target"), kZoneRadius);
   }
 
   std::vector<Waypoint> expert_waypoints(const sim::World& world) const override {
-    auto waypoints = grasp_and_lift(world, world.object_id("target"), 0.15);
-    Waypoint into_zone = waypoints.back();
-    into_zone.tcp_pose.translation() = world.object_pose(world.object_id("success_zone")).translation();
-    into_zone.ignore_collisions = false;
-    waypoints.push_back(into_zone);
-    return waypoints;
+    return lift_into_zone(world, world.object_id("target"));
   }
 };
 

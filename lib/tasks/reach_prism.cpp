@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "tasks/catalogue.hpp"
+#include "tasks/shapes.hpp"
 
 namespace qte::tasks {
 namespace {
@@ -12,26 +13,6 @@ namespace {
 constexpr double kHeight = 0.03;
 constexpr double kReachAbove = 0.02;   // the reach point: this far above the prism's top face
 constexpr double kReachRadius = 0.025;  // success: the TCP within this of the reach point
-
-// A regular prism standing on the table: `sides` vertices on a circle of `radius` (object frame,
-// z up, centred), yawed by `yaw_rad`.
-sim::ObjectSpec regular_prism(const sim::World& world, const std::string& name, int sides, double radius,
-                              const Eigen::Vector3d& xy, double yaw_rad) {
-  sim::ObjectSpec spec;
-  spec.name = name;
-  spec.shape = sim::ObjectSpec::Shape::convex_hull;
-  for (double z : {-kHeight / 2, kHeight / 2})
-    for (int i = 0; i < sides; ++i) {
-      const double angle = 2 * M_PI * i / sides;
-      spec.hull_points.emplace_back(radius * std::cos(angle), radius * std::sin(angle), z);
-    }
-  spec.pose.linear() = Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  spec.pose.translation() << xy.x(), xy.y(), world.layout().table_height_m + kHeight / 2;
-  spec.mass_kg = 0;  // fixed where placed: reaching does not move it
-  spec.graspable = false;
-  spec.appearance.colour = Eigen::Vector3f(0.95f, 0.8f, 0.1f);
-  return spec;
-}
 
 class ReachPrism : public Task {
  public:
@@ -44,9 +25,14 @@ class ReachPrism : public Task {
     std::uniform_real_distribution<double> yaw(-M_PI, M_PI);
     // Footprints 4.0-4.3 cm across: the pentagon's 2.1 cm circumradius, the triangle's 2.5 cm
     // (4.3 cm sides), the cube's 3 cm sides (4.2 cm diagonal).
-    world.add_object(regular_prism(world, "prism", 5, 0.021, positions[0], yaw(rng)));
-    world.add_object(regular_prism(world, "triangular_prism", 3, 0.025, positions[1], yaw(rng)));
-    world.add_object(regular_prism(world, "cube", 4, 0.03 / std::sqrt(2.0), positions[2], yaw(rng)));
+    const Eigen::Vector3f yellow(0.95f, 0.8f, 0.1f);
+    auto prism = [&](const std::string& name, int sides, double radius, const Eigen::Vector3d& xy) {
+      // Fixed where placed: reaching does not move it.
+      world.add_object(standing_prism(world, name, {regular_polygon(sides, radius)}, kHeight, xy, yaw(rng), yellow));
+    };
+    prism("prism", 5, 0.021, positions[0]);
+    prism("triangular_prism", 3, 0.025, positions[1]);
+    prism("cube", 4, 0.03 / std::sqrt(2.0), positions[2]);
   }
 
   bool success(const sim::World& world) const override {

@@ -8,7 +8,7 @@
 namespace qte::tasks {
 
 std::vector<std::string> task_names() {
-  return {"reach_target", "pick_and_lift", "lift_numbered_block", "reach_prism"};
+  return {"reach_target", "pick_and_lift", "lift_numbered_block", "reach_prism", "pick_and_lift_small"};
 }
 
 std::unique_ptr<Task> make_task(const std::string& name) {
@@ -16,6 +16,7 @@ std::unique_ptr<Task> make_task(const std::string& name) {
   if (name == "pick_and_lift") return make_pick_and_lift();
   if (name == "lift_numbered_block") return make_lift_numbered_block();
   if (name == "reach_prism") return make_reach_prism();
+  if (name == "pick_and_lift_small") return make_pick_and_lift_small();
   std::string known;
   for (const auto& n : task_names()) known += (known.empty() ? "" : ", ") + n;
   throw Error("unknown task '" + name + "' (known tasks: " + known + ")");
@@ -62,6 +63,17 @@ std::vector<Eigen::Vector3d> sample_separated(std::mt19937_64& rng, int count,
   }
   throw Error("cannot place " + std::to_string(count) + " objects " +
               std::to_string(min_distance_m) + " m apart in the task region");
+}
+
+Eigen::Vector3d sample_away_from(std::mt19937_64& rng, const std::vector<Eigen::Vector3d>& others,
+                                 const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double min_distance_m) {
+  for (int attempt = 0; attempt < 1000; ++attempt) {
+    Eigen::Vector3d p;
+    for (int k = 0; k < 3; ++k) p[k] = std::uniform_real_distribution<double>(lo[k], hi[k])(rng);
+    if (std::all_of(others.begin(), others.end(), [&](const Eigen::Vector3d& o) { return (p - o).norm() >= min_distance_m; }))
+      return p;
+  }
+  throw Error("cannot place an object " + std::to_string(min_distance_m) + " m from the others in the task region");
 }
 
 std::vector<int> pick_distinct(std::mt19937_64& rng, int count, int range, int excluded) {

@@ -88,7 +88,7 @@ TEST(Simulator, UnknownTaskIsAnErrorListingTheTasks) {
     run.send(reset_record("open_drawer", 0, 1));
     FAIL();
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("known tasks: reach_target, pick_and_lift, lift_numbered_block, reach_prism"),
+    EXPECT_NE(std::string(e.what()).find("known tasks: reach_target, pick_and_lift, lift_numbered_block, reach_prism, pick_and_lift_small"),
               std::string::npos);
     EXPECT_NE(std::string(e.what()).find("'reset' record, field 'task'"), std::string::npos) << e.what();
   }
@@ -235,7 +235,7 @@ TEST_P(ExpertSolves, SeveralSeeds) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Tasks, ExpertSolves,
-                         ::testing::Values("reach_target", "pick_and_lift", "lift_numbered_block", "reach_prism"));
+                         ::testing::Values("reach_target", "pick_and_lift", "lift_numbered_block", "reach_prism", "pick_and_lift_small"));
 
 // Demonstration, exploration and evaluation scenes never meet, for any run seed: with the
 // seeds examples/learn.sh gives (demo-record --seed S, sim-step --seed S * 100000 + chunk

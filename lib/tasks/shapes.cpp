@@ -1,0 +1,77 @@
+#include "tasks/shapes.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace qte::tasks {
+
+Polygon regular_polygon(int sides, double radius) {
+  Polygon polygon;
+  for (int i = 0; i < sides; ++i) {
+    const double angle = 2 * M_PI * i / sides;
+    polygon.emplace_back(radius * std::cos(angle), radius * std::sin(angle));
+  }
+  return polygon;
+}
+
+std::vector<Polygon> star_pieces(int points, double outer, double inner) {
+  auto at = [](double radius, double angle) { return Eigen::Vector2d(radius * std::cos(angle), radius * std::sin(angle)); };
+  const double step = 2 * M_PI / points;
+  std::vector<Polygon> pieces;
+  for (int i = 0; i < points; ++i) {
+    const double tip = M_PI / 2 + i * step;
+    pieces.push_back({Eigen::Vector2d::Zero(), at(inner, tip - step / 2), at(outer, tip), at(inner, tip + step / 2)});
+  }
+  return pieces;
+}
+
+std::vector<Polygon> crescent_pieces(double radius, double offset, int slices) {
+  // Across y, the crescent is x in [-s, min(s, offset - s)] with s = sqrt(r^2 - y^2).
+  auto section = [&](double y) {
+    const double s = std::sqrt(std::max(0.0, radius * radius - y * y));
+    return std::pair(Eigen::Vector2d(-s, y), Eigen::Vector2d(std::min(s, offset - s), y));
+  };
+  std::vector<Polygon> pieces;
+  double low = 0, high = 0;  // the strips' extent in x
+  for (int i = 0; i < slices; ++i) {
+    // Even steps in angle: finer strips where the outline curves fastest, at the tips.
+    const double y0 = radius * std::sin(-M_PI / 2 + M_PI * i / slices);
+    const double y1 = radius * std::sin(-M_PI / 2 + M_PI * (i + 1) / slices);
+    const auto [a0, b0] = section(y0);
+    const auto [a1, b1] = section(y1);
+    pieces.push_back({a0, b0, b1, a1});
+    low = std::min({low, a0.x(), a1.x()});
+    high = std::max({high, b0.x(), b1.x()});
+  }
+  for (Polygon& piece : pieces)
+    for (Eigen::Vector2d& p : piece) p.x() -= (low + high) / 2;
+  return pieces;
+}
+
+sim::ObjectSpec standing_prism(const sim::World& world, const std::string& name,
+                               const std::vector<Polygon>& footprint, double height,
+                               const Eigen::Vector3d& xy, double yaw_rad, const Eigen::Vector3f& colour) {
+  sim::ObjectSpec spec;
+  spec.name = name;
+  for (const Polygon& polygon : footprint) {
+    std::vector<Eigen::Vector3d> piece;
+    for (double z : {-height / 2, height / 2})
+      for (const Eigen::Vector2d& p : polygon) piece.emplace_back(p.x(), p.y(), z);
+    spec.pieces.push_back(piece);
+  }
+  if (spec.pieces.size() == 1) {
+    spec.shape = sim::ObjectSpec::Shape::convex_hull;
+    spec.hull_points = spec.pieces.front();
+    spec.pieces.clear();
+  } else {
+    spec.shape = sim::ObjectSpec::Shape::compound;
+  }
+  spec.pose.linear() = Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  spec.pose.translation() << xy.x(), xy.y(), world.layout().table_height_m + height / 2;
+  spec.mass_kg = 0;
+  spec.graspable = false;
+  spec.appearance.colour = colour;
+  return spec;
+}
+
+}  // namespace qte::tasks
