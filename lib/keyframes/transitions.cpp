@@ -147,7 +147,8 @@ stream::Record frame_record(const stream::Record& obs, int64_t episode_key) {
       frame.add(field);
     }
   }
-  for (const char* name : {"joint_positions", "gripper_pose", "gripper_open", "gripper_opening_m", "task", "variation"})
+  for (const char* name : {"joint_positions", "gripper_pose", "gripper_open", "gripper_opening_m", "episode_length", "task",
+                           "variation"})
     if (obs.has(name)) frame.add(obs.field(name));
   return frame;
 }

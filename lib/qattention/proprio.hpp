@@ -1,6 +1,7 @@
 // The proprioception every Q-attention network sees, tiled over its voxels: gripper open,
 // the two finger positions (half the opening each, metres), and the episode time, scaled as
-// C2F-ARM does: 1 at the first next-best pose, -1 at the last.
+// C2F-ARM does: 1 at the first next-best pose, -1 at the last (of the record's
+// episode_length; streams recorded before tasks had their own lengths: 10).
 #pragma once
 
 #include <vector>
@@ -10,7 +11,7 @@
 namespace qte::qattention {
 
 constexpr int kProprio = 4;
-constexpr int kEpisodeLength = 10;  // next-best poses per episode (tasks::Task::kEpisodeLength)
+constexpr int kEpisodeLength = 10;  // when a record has no episode_length (tasks::Task::kEpisodeLength)
 
 // From an 'obs' or 'frame' record (gripper_open, gripper_opening_m) and the number of
 // next-best poses taken before it. Throws StreamError naming a missing field.

@@ -11,6 +11,7 @@ namespace qte::simulator {
 namespace {
 
 constexpr double kStartTolerance_rad = 1e-3;  // a trajectory must start where the arm is
+constexpr double kSettleAfterRelease_s = 0.5;  // physics after opening on a held object
 
 // Flattens an Eigen matrix row-major (the stream's C order).
 template <class Matrix>
@@ -96,6 +97,7 @@ stream::Record Simulator::observe(const std::string& failure) {
   obs.set_scalar<uint8_t>("gripper_open", world_->gripper_open());
   obs.set_scalar<double>("gripper_opening_m", world_->finger_opening_m());
   obs.set_scalar<int32_t>("step", step_);
+  obs.set_scalar<int32_t>("episode_length", task_->episode_length());
   obs.set_scalar<int32_t>("frame", frame_++);
   obs.set_scalar<double>("time_s", time_s_);
   obs.set_scalar<float>("reward", success_ ? tasks::Task::kSuccessReward : 0.0f);
@@ -215,13 +217,21 @@ void Simulator::execute(const stream::Record& record,
     if (failure.empty() && record.has("gripper_open")) {
       const bool open = record.scalar<uint8_t>("gripper_open") != 0;
       const bool is_open = world_->gripper_open();
-      if (open && !is_open) world_->open_gripper();
+      if (open && !is_open) {
+        // Placing: a released object comes to rest before success is judged (stacks, checkers).
+        const bool releasing = world_->held_object() >= 0;
+        world_->open_gripper();
+        if (releasing) {
+          world_->settle(kSettleAfterRelease_s);
+          time_s_ += kSettleAfterRelease_s;
+        }
+      }
       if (!open && is_open) world_->close_gripper();
       if (open != is_open) time_s_ += 0.25;
     }
   }
   success_ = failure.empty() && task_->success(*world_);
-  terminal_ = success_ || !failure.empty() || step_ >= tasks::Task::kEpisodeLength;
+  terminal_ = success_ || !failure.empty() || step_ >= task_->episode_length();
   emit(observe(failure));
 }
 

@@ -16,6 +16,7 @@ std::unique_ptr<Task> make_pick_and_lift();
 std::unique_ptr<Task> make_lift_numbered_block();
 std::unique_ptr<Task> make_reach_prism();
 std::unique_ptr<Task> make_pick_and_lift_small();
+std::unique_ptr<Task> make_stack_blocks();
 
 struct NamedColour {
   std::string name;
@@ -27,6 +28,10 @@ const std::vector<NamedColour>& colours();
 std::vector<Eigen::Vector3d> sample_separated(std::mt19937_64& rng, int count,
                                               const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
                                               double min_distance_m);
+// As sample_separated, placing one point at a time (a layout too dense for drawing all at
+// once); sample_separated stays as it is, since it decides the older tasks' scenes.
+std::vector<Eigen::Vector3d> place_one_by_one(std::mt19937_64& rng, int count, const Eigen::Vector3d& lo,
+                                              const Eigen::Vector3d& hi, double min_distance_m);
 // A point uniform in the box [lo, hi] at least `min_distance_m` from each of `others`.
 Eigen::Vector3d sample_away_from(std::mt19937_64& rng, const std::vector<Eigen::Vector3d>& others,
                                  const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double min_distance_m);

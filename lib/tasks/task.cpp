@@ -8,7 +8,8 @@
 namespace qte::tasks {
 
 std::vector<std::string> task_names() {
-  return {"reach_target", "pick_and_lift", "lift_numbered_block", "reach_prism", "pick_and_lift_small"};
+  return {"reach_target", "pick_and_lift", "lift_numbered_block", "reach_prism", "pick_and_lift_small",
+          "stack_blocks"};
 }
 
 std::unique_ptr<Task> make_task(const std::string& name) {
@@ -17,6 +18,7 @@ std::unique_ptr<Task> make_task(const std::string& name) {
   if (name == "lift_numbered_block") return make_lift_numbered_block();
   if (name == "reach_prism") return make_reach_prism();
   if (name == "pick_and_lift_small") return make_pick_and_lift_small();
+  if (name == "stack_blocks") return make_stack_blocks();
   std::string known;
   for (const auto& n : task_names()) known += (known.empty() ? "" : ", ") + n;
   throw Error("unknown task '" + name + "' (known tasks: " + known + ")");
@@ -63,6 +65,20 @@ std::vector<Eigen::Vector3d> sample_separated(std::mt19937_64& rng, int count,
   }
   throw Error("cannot place " + std::to_string(count) + " objects " +
               std::to_string(min_distance_m) + " m apart in the task region");
+}
+
+std::vector<Eigen::Vector3d> place_one_by_one(std::mt19937_64& rng, int count, const Eigen::Vector3d& lo,
+                                              const Eigen::Vector3d& hi, double min_distance_m) {
+  for (int layout = 0; layout < 100; ++layout) {
+    std::vector<Eigen::Vector3d> points;
+    try {
+      while (static_cast<int>(points.size()) < count) points.push_back(sample_away_from(rng, points, lo, hi, min_distance_m));
+      return points;
+    } catch (const Error&) {  // boxed in: start the layout again
+    }
+  }
+  throw Error("cannot place " + std::to_string(count) + " objects " + std::to_string(min_distance_m) +
+              " m apart in the task region");
 }
 
 Eigen::Vector3d sample_away_from(std::mt19937_64& rng, const std::vector<Eigen::Vector3d>& others,

@@ -32,7 +32,10 @@ class Task {
   virtual bool success(const sim::World& world) const = 0;
   virtual std::vector<Waypoint> expert_waypoints(const sim::World& world) const = 0;
 
-  static constexpr int kEpisodeLength = 10;  // next-best poses per episode
+  // Next-best poses per episode: the published 10, more where the expert needs more
+  // (its keyframes plus slack). The 'obs' records carry it as episode_length.
+  virtual int episode_length() const { return kEpisodeLength; }
+  static constexpr int kEpisodeLength = 10;
   static constexpr float kSuccessReward = 100.0f;
 };
 

@@ -68,6 +68,7 @@ TEST(Simulator, ResetWritesAFullObservation) {
   EXPECT_EQ(obs.array<double>("joint_positions").size(), 7);
   EXPECT_EQ(obs.scalar<int32_t>("step"), 0);
   EXPECT_EQ(obs.scalar<uint8_t>("terminal"), 0);
+  EXPECT_EQ(obs.scalar<int32_t>("episode_length"), 10);
   EXPECT_EQ(obs.scalar<uint8_t>("gripper_open"), 1);
   EXPECT_EQ(obs.string("task"), "reach_target");
 }
@@ -88,7 +89,7 @@ TEST(Simulator, UnknownTaskIsAnErrorListingTheTasks) {
     run.send(reset_record("open_drawer", 0, 1));
     FAIL();
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("known tasks: reach_target, pick_and_lift, lift_numbered_block, reach_prism, pick_and_lift_small"),
+    EXPECT_NE(std::string(e.what()).find("known tasks: reach_target, pick_and_lift, lift_numbered_block, reach_prism, pick_and_lift_small, stack_blocks"),
               std::string::npos);
     EXPECT_NE(std::string(e.what()).find("'reset' record, field 'task'"), std::string::npos) << e.what();
   }
@@ -235,7 +236,8 @@ TEST_P(ExpertSolves, SeveralSeeds) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Tasks, ExpertSolves,
-                         ::testing::Values("reach_target", "pick_and_lift", "lift_numbered_block", "reach_prism", "pick_and_lift_small"));
+                         ::testing::Values("reach_target", "pick_and_lift", "lift_numbered_block", "reach_prism", "pick_and_lift_small",
+                                           "stack_blocks"));
 
 // Demonstration, exploration and evaluation scenes never meet, for any run seed: with the
 // seeds examples/learn.sh gives (demo-record --seed S, sim-step --seed S * 100000 + chunk
