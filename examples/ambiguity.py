@@ -4,6 +4,9 @@ observation of a demonstration, the target being the one the expert first closes
 over (or, if it never does, the one its last pose is over).
 
     ambiguity.py centres DEMO.rec               one line per object, x,y,z (target first)
+    ambiguity.py places DEMO.rec                where the expert first releases what it holds
+                                                (the target), then 4 cm along x and 4 cm along
+                                                x and y from there (setup_checkers' neighbours)
     ambiguity.py compare VOXELS.rec             after voxelize --centre <each of them>: the
                                                 depth-0 voxel of each object (its 10 channels)
                                                 and the top view of its depth-1 grid
@@ -47,6 +50,16 @@ def centres(path):
         print(f"{c[0]:.4f},{c[1]:.4f},{c[2]:.4f}")
 
 
+def places(path):
+    records = [r for r in read_records(path) if r.type == "obs"]
+    opened = [int(np.asarray(r.fields["gripper_open"]).reshape(-1)[0]) for r in records]
+    release = next(i for i in range(1, len(records)) if opened[i] and not opened[i - 1])
+    target = np.asarray(records[release].fields["gripper_pose"])[:3]
+    for shift in ((0, 0), (0.04, 0), (0.04, 0.04)):
+        c = target + np.array([shift[0], shift[1], 0.0])
+        print(f"{c[0]:.4f},{c[1]:.4f},{c[2]:.4f}")
+
+
 def compare(path):
     voxels = next(r for r in read_records(path) if r.type == "voxels")
     coarse, coarse_bounds = np.asarray(voxels.fields["depth0.grid"]), np.asarray(voxels.fields["depth0.bounds"])
@@ -82,9 +95,17 @@ def compare(path):
         cells = ", ".join(f"{v:d}" for v in layers[layers > 0])
         print(f"  {name:13s} {int(above.sum()):2d} occupied voxels above the table (per layer: {cells}); "
               f"their points' mean positions span {extent[0]:.1f} x {extent[1]:.1f} x {extent[2]:.1f} cm")
+    for k, name in enumerate(names):
+        # What the grid's centre column shows from above: its highest occupied voxel.
+        column = fine[k, n // 2, n // 2]
+        occupied = np.nonzero(column[:, 9] > 0)[0]
+        if len(occupied):
+            top = column[occupied[-1]]
+            print(f"  {name:13s} centre column's top voxel: mean z {top[2]:.3f} m, r g b "
+                  + " ".join(f"{v:+.3f}" for v in top[3:6]))
     for k in range(1, len(views)):
         print(f"  target vs {names[k]}: {np.sum(views[0] != views[k])} of 64 top-view cells differ")
 
 
 if __name__ == "__main__":
-    {"centres": centres, "compare": compare}[sys.argv[1]](sys.argv[2])
+    {"centres": centres, "places": places, "compare": compare}[sys.argv[1]](sys.argv[2])

@@ -2,14 +2,16 @@
 # Pictures and numbers of a task's coarse ambiguity (README, "The tasks"): the first front
 # frame of one demonstration, what depth 0 sees, the depth-1 grids around the target and the
 # distractors, and ambiguity.py's comparison of them.
-# Usage: ambiguity.sh TASK [SEED] [IMAGE]   (with the built programs on PATH; writes
-#        examples/images/TASK_depth0.png, TASK_depth1_target.png, TASK_depth1_distractor.png)
+# Usage: ambiguity.sh TASK [SEED] [IMAGE] [centres|places]   (with the built programs on
+#        PATH; writes examples/images/TASK_depth0.png, TASK_depth1_target.png,
+#        TASK_depth1_distractor.png). `places`: around where the expert puts things instead
+#        (setup_checkers: the target square and its neighbours).
 set -euo pipefail
-task=$1 seed=${2:-1} image=${3:-256x256}
+task=$1 seed=${2:-1} image=${3:-256x256} around=${4:-centres}
 here=$(cd "$(dirname "$0")" && pwd)
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 demo-record --task "$task" --episodes 1 --seed "$seed" --image-size "$image" --output "$tmp/demo.rec" 2>/dev/null
-centres=$(/usr/bin/python3 "$here/ambiguity.py" centres "$tmp/demo.rec")
+centres=$(/usr/bin/python3 "$here/ambiguity.py" "$around" "$tmp/demo.rec")
 args=(); for c in $centres; do args+=(--centre "$c"); done
 stream-cat --type obs --head 1 "$tmp/demo.rec" | voxelize "${args[@]}" --png "$tmp/png" --output "$tmp/voxels.rec"
 /usr/bin/python3 "$here/ambiguity.py" compare "$tmp/voxels.rec"

@@ -180,6 +180,9 @@ while :; do
   done
 done
 touch "$run/actor.done"
+# Out of budget: the learner would go on to the steps the replay allows, past the budget and
+# never evaluated; stop it (its checkpoints are whole files, written under temporary names).
+[ "$finished" != 2 ] || kill $learner 2>/dev/null || true
 wait $learner || true
 trap - EXIT
 cat "$run"/eval/*.csv | awk 'NR == 1 || !/^label/' > "$run/eval.csv"

@@ -22,7 +22,7 @@ static cli::Usage usage() {
       "said per episode.",
   };
   u.options = {
-      {"task", "T", "reach_target, pick_and_lift, lift_numbered_block, reach_prism or pick_and_lift_small", ""},
+      {"task", "T", "reach_target, pick_and_lift, lift_numbered_block, reach_prism, pick_and_lift_small, stack_blocks or setup_checkers", ""},
       {"episodes", "N", "number of demonstrations", "10"},
       {"variation", "V", "task variation, or 'random' for one per episode", "0"},
       {"scenes", "SET", "the scene set episodes are drawn from: demo (disjoint from sim-step's explore and eval "

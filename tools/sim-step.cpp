@@ -32,9 +32,9 @@ static cli::Usage usage() {
       "output and reads its input to the end, so that an actor loop closed by a FIFO "
       "winds down without broken pipes.",
       "Cameras are rendered without a GPU, one ray per pixel against Bullet's collision world, "
-      "with per-object colours, diffuse shading and textures (the digits of "
-      "lift_numbered_block). Tasks: reach_target, pick_and_lift, lift_numbered_block, reach_prism, "
-      "pick_and_lift_small.",
+      "with per-object colours, diffuse shading and textures (the digits of lift_numbered_block, "
+      "the board of setup_checkers). Tasks: reach_target, pick_and_lift, lift_numbered_block, reach_prism, "
+      "pick_and_lift_small, stack_blocks, setup_checkers.",
   };
   u.arguments = {{"FILE", "input records; '-' or absent is standard input", true, false}};
   u.options = {

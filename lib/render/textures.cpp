@@ -42,4 +42,14 @@ cv::Mat text_texture(const std::string& text, int size_px, const Eigen::Vector3f
   return image;
 }
 
+cv::Mat checkerboard_texture(int squares, const Eigen::Vector3f& light, const Eigen::Vector3f& dark) {
+  if (squares < 1 || squares > 1024)
+    throw Error("checkerboard_texture: squares must be 1 to 1024, got " + std::to_string(squares));
+  cv::Mat image(squares, squares, CV_8UC3, rgb_scalar(light));
+  for (int row = 0; row < squares; ++row)      // from the bottom (image rows run down)
+    for (int column = 0; column < squares; ++column)
+      if ((row + column) % 2 == 0) image(cv::Rect(column, squares - 1 - row, 1, 1)).setTo(rgb_scalar(dark));
+  return image;
+}
+
 }  // namespace qte::render

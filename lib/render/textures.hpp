@@ -13,4 +13,9 @@ namespace qte::render {
 cv::Mat text_texture(const std::string& text, int size_px, const Eigen::Vector3f& paper,
                      const Eigen::Vector3f& ink);
 
+// A board of `squares` x `squares` (RGB, CV_8UC3, one pixel a square: faces are sampled
+// nearest-neighbour), `dark` where row + column is even, counted from the image's bottom
+// left (the face's -x, -y corner, see Appearance). Throws Error for squares outside 1..1024.
+cv::Mat checkerboard_texture(int squares, const Eigen::Vector3f& light, const Eigen::Vector3f& dark);
+
 }  // namespace qte::render

@@ -17,6 +17,7 @@ std::unique_ptr<Task> make_lift_numbered_block();
 std::unique_ptr<Task> make_reach_prism();
 std::unique_ptr<Task> make_pick_and_lift_small();
 std::unique_ptr<Task> make_stack_blocks();
+std::unique_ptr<Task> make_setup_checkers();
 
 struct NamedColour {
   std::string name;

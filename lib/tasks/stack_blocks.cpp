@@ -3,7 +3,8 @@
 // colour on the plane (RLBench's stack_blocks). Variation v: colour v / 3 of the 20, stack
 // height 2 + v % 3 (60 variations). The expert takes six next-best poses a block: above it,
 // grasp, lift, above the stack, place (the gripper opens and physics settles the block),
-// back up; 4 blocks need 24, so episodes are 30 long, not the published 10.
+// back up (but after the last: the episode ends at success); 4 blocks need 23, so episodes
+// are 30 long, not the published 10.
 #include <algorithm>
 
 #include "tasks/blocks.hpp"
@@ -86,6 +87,7 @@ class StackBlocks : public Task {
       place.gripper_open = true;  // opened on arrival: released
       waypoints.insert(waypoints.end(), {over, place, retreat});
     }
+    waypoints.pop_back();  // the last release completes the task: the episode ends there
     return waypoints;
   }
 

@@ -9,7 +9,7 @@ namespace qte::tasks {
 
 std::vector<std::string> task_names() {
   return {"reach_target", "pick_and_lift", "lift_numbered_block", "reach_prism", "pick_and_lift_small",
-          "stack_blocks"};
+          "stack_blocks", "setup_checkers"};
 }
 
 std::unique_ptr<Task> make_task(const std::string& name) {
@@ -19,6 +19,7 @@ std::unique_ptr<Task> make_task(const std::string& name) {
   if (name == "reach_prism") return make_reach_prism();
   if (name == "pick_and_lift_small") return make_pick_and_lift_small();
   if (name == "stack_blocks") return make_stack_blocks();
+  if (name == "setup_checkers") return make_setup_checkers();
   std::string known;
   for (const auto& n : task_names()) known += (known.empty() ? "" : ", ") + n;
   throw Error("unknown task '" + name + "' (known tasks: " + known + ")");

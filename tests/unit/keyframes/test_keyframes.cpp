@@ -145,7 +145,9 @@ TEST_P(ExpertKeyframes, MatchTheExpertsWaypoints) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Tasks, ExpertKeyframes, ::testing::Values("reach_target", "pick_and_lift", "lift_numbered_block"));
+INSTANTIATE_TEST_SUITE_P(Tasks, ExpertKeyframes,
+                         ::testing::Values("reach_target", "pick_and_lift", "lift_numbered_block", "reach_prism",
+                                           "pick_and_lift_small", "stack_blocks", "setup_checkers"));
 
 namespace {
 

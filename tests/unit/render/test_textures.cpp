@@ -68,3 +68,16 @@ TEST(TextureText, RejectsEmptyTextAndSillySizes) {
   EXPECT_THROW(text_texture("2", 0, {1, 1, 1}, {0, 0, 0}), Error);
   EXPECT_THROW(text_texture("2", 100000, {1, 1, 1}, {0, 0, 0}), Error);
 }
+
+TEST(TextureCheckerboard, DarkWhereRowPlusColumnIsEvenFromTheBottomLeft) {
+  const cv::Mat board = checkerboard_texture(8, {1.0f, 1.0f, 1.0f}, {0.0f, 0.5f, 0.0f});
+  ASSERT_EQ(board.rows, 8);
+  ASSERT_EQ(board.cols, 8);
+  for (int row = 0; row < 8; ++row)
+    for (int column = 0; column < 8; ++column) {
+      const cv::Vec3b pixel = board.at<cv::Vec3b>(7 - row, column);
+      const bool dark = (row + column) % 2 == 0;
+      EXPECT_EQ(pixel, dark ? cv::Vec3b(0, 128, 0) : cv::Vec3b(255, 255, 255)) << row << " " << column;
+    }
+  EXPECT_THROW(checkerboard_texture(0, {1, 1, 1}, {0, 0, 0}), Error);
+}

@@ -89,7 +89,7 @@ TEST(Simulator, UnknownTaskIsAnErrorListingTheTasks) {
     run.send(reset_record("open_drawer", 0, 1));
     FAIL();
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("known tasks: reach_target, pick_and_lift, lift_numbered_block, reach_prism, pick_and_lift_small, stack_blocks"),
+    EXPECT_NE(std::string(e.what()).find("known tasks: reach_target, pick_and_lift, lift_numbered_block, reach_prism, pick_and_lift_small, stack_blocks, setup_checkers"),
               std::string::npos);
     EXPECT_NE(std::string(e.what()).find("'reset' record, field 'task'"), std::string::npos) << e.what();
   }
@@ -237,7 +237,7 @@ TEST_P(ExpertSolves, SeveralSeeds) {
 
 INSTANTIATE_TEST_SUITE_P(Tasks, ExpertSolves,
                          ::testing::Values("reach_target", "pick_and_lift", "lift_numbered_block", "reach_prism", "pick_and_lift_small",
-                                           "stack_blocks"));
+                                           "stack_blocks", "setup_checkers"));
 
 // Demonstration, exploration and evaluation scenes never meet, for any run seed: with the
 // seeds examples/learn.sh gives (demo-record --seed S, sim-step --seed S * 100000 + chunk
