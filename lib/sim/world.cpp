@@ -27,7 +27,7 @@ Eigen::Isometry3d from_bullet(const btTransform& t) {
 std::unique_ptr<btConvexHullShape> make_hull(const std::vector<Eigen::Vector3d>& points) {
   auto hull = std::make_unique<btConvexHullShape>();
   for (const auto& p : points) hull->addPoint(btVector3(p.x(), p.y(), p.z()), false);
-  hull->setMargin(0.001);
+  hull->setMargin(kHullMargin);
   hull->recalcLocalAabb();  // after the margin: the cached box includes it (default 4 cm)
   return hull;
 }

@@ -16,6 +16,11 @@ class btCollisionWorld;
 
 namespace qte::sim {
 
+// Bullet's collision margin around convex hulls (and compounds of them): a hull rests this
+// far above what it stands on, and two stacked hulls twice this apart. Cameras see the hull
+// itself. Spawn resting hulls this high, or they start interpenetrating and jump.
+constexpr double kHullMargin = 0.001;
+
 struct ObjectSpec {
   enum class Shape { box, cylinder, sphere, convex_hull, compound };
   std::string name;

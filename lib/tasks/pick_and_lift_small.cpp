@@ -44,6 +44,7 @@ class PickAndLiftSmall : public Task {
     const Eigen::Vector3f colour(0.2f, 0.45f, 0.95f);
     for (int i = 0; i < 5; ++i) {
       sim::ObjectSpec spec = standing_prism(world, kShapes[i], footprint(kShapes[i]), kSize, positions[i], yaw(rng), colour);
+      spec.pose.translation().z() += sim::kHullMargin;  // resting on its margin
       spec.mass_kg = 0.03;
       spec.graspable = true;
       world.add_object(spec);

@@ -18,7 +18,7 @@ namespace {
 constexpr double kSquare = 0.04, kBoardThickness = 0.01;
 constexpr double kCheckerRadius = 0.0179, kCheckerHeight = 0.0072;
 constexpr double kHomeTolerance = 0.01;  // a checker's centre within this of its square's (xy)
-constexpr double kAbove = 0.06;          // approach and carry height over the board
+constexpr double kAbove = 0.1;           // approach and carry height over the board
 
 class SetupCheckers : public Task {
  public:
@@ -50,7 +50,8 @@ class SetupCheckers : public Task {
     for (int row : {0, 1, 2, 5, 6, 7})
       for (int column = 0; column < 8; ++column)
         if ((row + column) % 2 == 0) {
-          const Eigen::Vector3d square((column - 3.5) * kSquare, (row - 3.5) * kSquare, kBoardThickness / 2 + kCheckerHeight / 2);
+          const Eigen::Vector3d square((column - 3.5) * kSquare, (row - 3.5) * kSquare,
+                                       kBoardThickness / 2 + sim::kHullMargin + kCheckerHeight / 2);
           homes_.push_back({(row < 4 ? "red" : "black") + std::to_string(homes_.size() % 12), square});
         }
     std::vector<int> order(homes_.size());
@@ -68,7 +69,8 @@ class SetupCheckers : public Task {
       const auto stacked = std::find(off_board_.begin(), off_board_.end(), static_cast<int>(i));
       checker.pose.translation() = stacked == off_board_.end()
           ? board * homes_[i].second
-          : spot + Eigen::Vector3d(0, 0, (stacked - off_board_.begin() + 0.5) * kCheckerHeight);
+          : spot + Eigen::Vector3d(0, 0, (stacked - off_board_.begin()) * (kCheckerHeight + 2 * sim::kHullMargin) +
+                                               sim::kHullMargin + kCheckerHeight / 2);
       checker.mass_kg = 0.01;
       checker.graspable = true;
       checker.appearance.colour = homes_[i].first[0] == 'r' ? Eigen::Vector3f(0.8f, 0.1f, 0.1f) : Eigen::Vector3f(0.12f, 0.12f, 0.12f);
