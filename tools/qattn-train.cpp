@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "cli/command.hpp"
+#include "qattention/branching_options.hpp"
 #include "learner/q_learner.hpp"
 #include "learner/training_files.hpp"
 #include "learner/training_loop.hpp"
@@ -97,7 +98,7 @@ static cli::Usage usage() {
       {"grad-clip-norm", "N", "clip each depth's gradient L2 norm to N (0: none)", "0"},
       {"q-reg", "L", "lambda of the lambda * mean|Q| regularisation", "1"},
       {"huber-delta", "D", "Huber loss threshold", "1"},
-      {"tree-target", "K", "bootstrap with tree expansion of K branches per non-leaf grid, ranked by the online and valued by the target networks (0: double DQN down the greedy path)", "0"},
+      {"tree-target", "K", "bootstrap with tree expansion of K branches per non-leaf grid, ranked by the online and valued by the target networks (0: double DQN down the greedy path); 'auto': as many as each node's Q volume asks for (--k-margin or --k-mass, at most --k-max)", "0"},
       {"n-step", "N", "bootstrap after N transitions of a chain, summing their discounted rewards", "1"},
       {"uniform", "", "uniform replay sampling instead of prioritised", ""},
       {"alpha", "A", "priority exponent", "0.7"},
@@ -105,6 +106,7 @@ static cli::Usage usage() {
       {"capacity", "N", "replay capacity in transitions (demos always kept)", "100000"},
       {"threads", "N", "LibTorch threads", "2"},
   };
+  for (auto& option : qattention::branching_options()) u.options.push_back(option);
   u.uses_randomness = true;
   u.examples = {
       {"qattn-train --checkpoint-dir ckpt --steps 2000 --metrics train.csv demos.rec",
@@ -135,7 +137,8 @@ static void run(const cli::Arguments& args) {
   config.grad_clip_norm = args.real("grad-clip-norm");
   config.q_regularisation = args.real("q-reg");
   config.huber_delta = args.real("huber-delta");
-  config.tree_target_k = static_cast<int>(args.integer("tree-target", 0, 100000));
+  config.tree_branching = qattention::parse_branching(args, "tree-target", 0);
+  config.tree_target_k = config.tree_branching.k;
   config.n_step = static_cast<int>(args.integer("n-step", 1, 10));
   config.validate();
   config.check_memory(static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE)));

@@ -13,6 +13,7 @@
 #include "nets/qattention_net.hpp"
 #include "qattention/acting.hpp"
 #include "qattention/action_record.hpp"
+#include "qattention/branching_options.hpp"
 #include "qattention/proprio.hpp"
 #include "stream/reader.hpp"
 #include "stream/writer.hpp"
@@ -41,6 +42,9 @@ static cli::Usage usage() {
       "the cloud and evaluated in one batched forward. A branch is worth (its voxel's Q + the "
       "value of the best branch below it) / 2, a last-depth grid its largest Q, and the agent "
       "acts on the best path (Algorithm 2 of the QTE paper); --k 1 is C2F-ARM's greedy choice. "
+      "--k auto spends branches where a node is unsure: every voxel whose Q is within --k-margin "
+      "of the node's best, or the fewest best voxels holding --k-mass of its softmax, at least "
+      "1 and at most --k-max; the action's 'branches' field says how many each depth expanded. "
       "The pose is the centre of the last depth's voxel, turned by the last network's best "
       "rotation bins (Euler 'xyz', 72 bins of 5 degrees); the gripper command is the better of "
       "open and close.",
@@ -64,7 +68,8 @@ static cli::Usage usage() {
   u.arguments = {{"FILE", "input records; '-' or absent is standard input", true, false}};
   u.options = {
       {"checkpoint", "FILE", "the networks: a 'checkpoint' record as qattn-train writes it (required)", ""},
-      {"k", "K", "voxels expanded per non-leaf grid; 1 is C2F-ARM's greedy choice", "10"},
+      {"k", "K", "voxels expanded per non-leaf grid; 1 is C2F-ARM's greedy choice; 'auto': as many as the "
+                 "node's Q volume asks for (--k-margin or --k-mass, at most --k-max)", "10"},
       {"voxels", "V", "voxels per side of every grid (default: the checkpoint's; must agree with it)", ""},
       {"depths", "D", "coarse-to-fine depths (default: the checkpoint's; must agree with it)", ""},
       {"bounds", "X,Y,Z,S", "scene bounds: minimum corner and edge length in metres (default: the checkpoint's, else -0.3,-0.5,0.6,1.0); must agree with the checkpoint's", ""},
@@ -82,6 +87,7 @@ static cli::Usage usage() {
       {"png", "DIR", "save the Q-values of every depth's grid as DIR/<n>.depth<d>.png", ""},
       {"output", "FILE", "where to write; '-' is standard output", "-"},
   };
+  for (auto& option : qattention::branching_options()) u.options.push_back(option);
   u.uses_randomness = true;
   u.examples = {
       {"sim-step --task reach_target --episodes 10 < fifo | qte-select --checkpoint ckpt.rec | plan-path > fifo",
@@ -117,8 +123,7 @@ double non_negative(const cli::Arguments& args, const std::string& name) {
 static void run(const cli::Arguments& args) {
   const std::string checkpoint = args.text("checkpoint");
   if (checkpoint.empty()) throw UsageError("--checkpoint FILE is required");
-  const int64_t k = args.integer("k", 1, 4096);
-  if (k < 1) throw UsageError("--k must be at least 1");
+  const qattention::Branching branching = qattention::parse_branching(args, "k", 1);
   const int64_t threads = args.integer("threads", 1, 256);
   if (threads < 1) throw UsageError("--threads must be at least 1");
   qattention::Exploration exploration;
@@ -186,7 +191,7 @@ static void run(const cli::Arguments& args) {
     std::optional<qattention::Action> chosen;
     try {
       chosen.emplace(
-          qattention::act(evaluate, hierarchy, observed.view(), proprio, static_cast<int>(k), exploration, rng));
+          qattention::act(evaluate, hierarchy, observed.view(), proprio, branching, exploration, rng));
     } catch (const StreamError&) {
       throw;
     } catch (const Error& e) {  // a diverged checkpoint: name the observation it failed on
@@ -194,7 +199,7 @@ static void run(const cli::Arguments& args) {
     }
     qattention::Action& action = *chosen;
     if (!png_dir.empty()) qattention::save_q_pictures(png_dir, actions, action);
-    writer.write(qattention::action_record(action.choice, ignore_collisions, static_cast<int>(k), action.explored,
+    writer.write(qattention::action_record(action.choice, ignore_collisions, branching.k, action.explored,
                                            networks.step(), step));
     actions += 1;
   }

@@ -110,6 +110,7 @@ StepStats QLearner::gradients(const Minibatch& batch) {
   stats.loss = total.item<double>();
   if (!std::isfinite(stats.loss)) throw Error("non-finite loss (" + std::to_string(stats.loss) + ")");
   stats.td_errors = td;
+  stats.mean_branches = targets.mean_branches;
 
   torch_->adam->zero_grad();
   total.backward();

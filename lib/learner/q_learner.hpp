@@ -24,6 +24,7 @@ struct StepStats {
   double loss = 0;
   std::vector<double> depth_loss, q_mean, q_max;  // per depth (translation Q of the batch)
   std::vector<double> td_errors;                  // per sample: mean over depths of |TD error|
+  std::vector<double> mean_branches;              // the tree target's, per non-leaf depth (Targets)
 };
 
 class QLearner {

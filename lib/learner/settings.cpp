@@ -1,5 +1,7 @@
 #include "learner/settings.hpp"
 
+#include "qattention/branching_options.hpp"
+
 #include <algorithm>
 #include <sstream>
 
@@ -19,7 +21,10 @@ std::string LearnerConfig::json() const {
     << ", \"tau\": " << tau << ", \"learning_rate\": " << learning_rate << ", \"weight_decay\": " << weight_decay
     << ", \"grad_clip_value\": " << grad_clip_value << ", \"grad_clip_norm\": " << grad_clip_norm
     << ", \"q_regularisation\": " << q_regularisation << ", \"huber_delta\": " << huber_delta
-    << ", \"tree_target_k\": " << tree_target_k << ", \"n_step\": " << n_step << "}";
+    << ", \"tree_target_k\": " << tree_target_k << ", \"n_step\": " << n_step;
+  if (tree_branching.adaptive())  // only then: checkpoints from before adaptive K still resume
+    s << ", \"tree_target\": \"" << qattention::describe(tree_branching) << "\"";
+  s << "}";
   return s.str();
 }
 

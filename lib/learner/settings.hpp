@@ -2,6 +2,8 @@
 // published value as default unless the README's table of settings says why not.
 #pragma once
 
+#include "qattention/tree_expansion.hpp"
+
 #include <string>
 
 #include "nets/qattention_net.hpp"
@@ -23,6 +25,9 @@ struct LearnerConfig {
   double q_regularisation = 1.0;  // lambda of lambda * mean|Q| (translation; and the head's 218 outputs)
   double huber_delta = 1.0;
   int tree_target_k = 0;  // 0: double DQN down the greedy path; K >= 1: tree expansion (online ranks, target values)
+  // With tree_target_k > 0, how the tree branches: fixed K = tree_target_k, or adaptive with
+  // at most tree_target_k branches per node (qattention::Branching).
+  qattention::Branching tree_branching;
   int n_step = 1;         // bootstrap after n transitions of a chain (the n-step return)
 
   // The settings a resumed run must share with its checkpoint, as JSON.

@@ -10,9 +10,10 @@ Targets bootstrap_targets(const qattention::DepthEvaluator& online, const qatten
   std::vector<voxels::PointCloud> clouds;
   for (const auto& c : batch.next_clouds) clouds.push_back(c.view());
   // K = 1 follows the online networks' greedy path: double DQN down the coarse-to-fine depths.
-  const int k = std::max(1, config.tree_target_k);
+  const qattention::Branching branching =
+      config.tree_branching.adaptive() ? config.tree_branching : qattention::Branching(std::max(1, config.tree_target_k));
   const std::vector<qattention::Choice> choices =
-      qattention::expand_batch(online, target, config.hierarchy, clouds, batch.next_proprio, k);
+      qattention::expand_batch(online, target, config.hierarchy, clouds, batch.next_proprio, branching);
 
   const float scale = static_cast<float>(config.reward_scale);
   const auto bootstrap = [&](int i, float next_value) {
@@ -29,6 +30,11 @@ Targets bootstrap_targets(const qattention::DepthEvaluator& online, const qatten
     }
     for (int axis = 0; axis < 3; ++axis) t.rotation.push_back(bootstrap(i, c.rotation_q[axis]));
     t.gripper.push_back(bootstrap(i, c.gripper_q));
+  }
+  if (config.tree_target_k > 0) {
+    t.mean_branches.assign(depths - 1, 0.0);
+    for (const qattention::Choice& c : choices)
+      for (int d = 0; d + 1 < depths; ++d) t.mean_branches[d] += static_cast<double>(c.branches[d]) / n;
   }
   return t;
 }

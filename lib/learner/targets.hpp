@@ -23,6 +23,7 @@ struct Targets {
   std::vector<std::vector<float>> translation;  // [depth][B]
   std::vector<float> rotation;                  // [B, 3]
   std::vector<float> gripper;                   // [B]
+  std::vector<double> mean_branches;            // per non-leaf depth: the tree's mean over the batch (none without a tree)
 };
 
 Targets bootstrap_targets(const qattention::DepthEvaluator& online, const qattention::DepthEvaluator& target,

@@ -25,11 +25,15 @@ bool is_agent_transition(const stream::Record& r) {
   return r.type() == "transition" && !(r.has("demo") && r.scalar<uint8_t>("demo") != 0);
 }
 
-std::string csv_header(int depths) {
+// With an adaptive tree target, the mean branches it expanded at depths 1.. come last.
+std::string csv_header(int depths, bool adaptive_tree) {
   std::string h = "step,transitions,agent_transitions,replay,demos,loss";
   for (int d = 0; d < depths; ++d) h += ",loss_d" + std::to_string(d);
   for (int d = 0; d < depths; ++d) h += ",q_mean_d" + std::to_string(d) + ",q_max_d" + std::to_string(d);
-  return h + ",td_mean,priority_mean,steps_per_s,elapsed_s";
+  h += ",td_mean,priority_mean,steps_per_s,elapsed_s";
+  if (adaptive_tree)
+    for (int d = 1; d < depths; ++d) h += ",branches_d" + std::to_string(d);
+  return h;
 }
 
 // Keeps the rows of an earlier run up to `step` (a resumed run rewrites what follows).
@@ -107,7 +111,8 @@ void TrainingLoop::save() {
 }
 
 bool TrainingLoop::start(bool resume) {
-  const std::string header = csv_header(learner_.config().hierarchy.depths);
+  const std::string header =
+      csv_header(learner_.config().hierarchy.depths, learner_.config().tree_branching.adaptive());
   bool resumed = false;
   if (resume && exists(checkpoints_.latest())) {
     const stream::Record state = learner_.load(checkpoints_.latest());
@@ -203,6 +208,8 @@ void TrainingLoop::log_row(const StepStats& stats) {
   for (std::size_t d = 0; d < stats.q_mean.size(); ++d) row << ',' << stats.q_mean[d] << ',' << stats.q_max[d];
   row << ',' << td_sum_ / std::max<int64_t>(1, td_count_) << ',' << priority_sum_ / std::max<int64_t>(1, td_count_)
       << ',' << rate << ',' << elapsed;
+  if (learner_.config().tree_branching.adaptive())
+    for (double b : stats.mean_branches) row << ',' << b;
   if (metrics_.is_open()) metrics_ << row.str() << '\n' << std::flush;
   progress_ << "qattn-train: step " << learner_.step() << "/" << options_.steps << "  loss " << std::setprecision(4)
             << stats.loss << "  q_max";

@@ -95,12 +95,14 @@ const GridQ& PathGrids::at(int depth) {
 }
 
 Action act(const DepthEvaluator& evaluate, const voxels::CoarseToFine& hierarchy, const voxels::PointCloud& cloud,
-           const std::vector<float>& proprio, int k, const Exploration& exploration, std::mt19937_64& rng) {
-  const Choice chosen = expand(evaluate, hierarchy, cloud, proprio, k);
-  const Explored explored = explore(chosen, exploration, rng, evaluate, hierarchy, cloud, proprio, k);
+           const std::vector<float>& proprio, const Branching& branching, const Exploration& exploration,
+           std::mt19937_64& rng) {
+  const Choice chosen = expand(evaluate, hierarchy, cloud, proprio, branching);
+  const Explored explored = explore(chosen, exploration, rng, evaluate, hierarchy, cloud, proprio, branching);
   const bool changed = !same_action(explored.choice, chosen);
   const Choice& taken = changed ? explored.choice : chosen;
   Action action{taken, changed, PathGrids(evaluate, cloud, proprio, taken.bounds)};
+  action.choice.branches = chosen.branches;
   if (changed) {
     Choice& c = action.choice;
     for (int d = 0; d < hierarchy.depths; ++d)

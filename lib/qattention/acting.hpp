@@ -92,9 +92,11 @@ struct Action {
   PathGrids grids;        // along choice's path
 };
 
-// Tree expansion with `k` branches per non-leaf grid, then `exploration` drawing from `rng`.
+// Tree expansion as `branching` says, then `exploration` drawing from `rng`. The action's
+// choice reports the tree's branches per depth even when exploration replaced a voxel.
 Action act(const DepthEvaluator& evaluate, const voxels::CoarseToFine& hierarchy, const voxels::PointCloud& cloud,
-           const std::vector<float>& proprio, int k, const Exploration& exploration, std::mt19937_64& rng);
+           const std::vector<float>& proprio, const Branching& branching, const Exploration& exploration,
+           std::mt19937_64& rng);
 
 // Saves a picture of every depth's grid along the action's path as DIR/<index>.depth<d>.png
 // (index from 000000): the occupied voxels coloured by Q, the chosen voxel outlined in red.

@@ -30,6 +30,7 @@ stream::Record action_record(const Choice& choice, bool ignore_collisions, int k
   a.set<int32_t>("rotation_bins", {3}, c.rotation_bins.data());
   a.set_scalar<float>("value", c.value);
   a.set_scalar<int32_t>("k", k);
+  if (!c.branches.empty()) a.set<int32_t>("branches", {static_cast<int64_t>(c.branches.size())}, c.branches);
   a.set_scalar<uint8_t>("explored", explored ? 1 : 0);
   a.set_scalar<int64_t>("checkpoint_step", checkpoint_step);
   a.set_scalar<int32_t>("step", step);

@@ -7,7 +7,7 @@ namespace qte::qattention {
 
 Explored explore(const Choice& chosen, const Exploration& exploration, std::mt19937_64& rng,
                  const DepthEvaluator& evaluate, const voxels::CoarseToFine& hierarchy,
-                 const voxels::PointCloud& cloud, const std::vector<float>& proprio, int k) {
+                 const voxels::PointCloud& cloud, const std::vector<float>& proprio, const Branching& branching) {
   Explored explored{chosen, {}};
   Choice& c = explored.choice;
   std::vector<bool>& replaced = explored.replaced;
@@ -28,7 +28,7 @@ Explored explore(const Choice& chosen, const Exploration& exploration, std::mt19
       const DepthEvaluator deeper_nets = [&evaluate, d](int j, const float* grids, const float* p, int batch) {
         return evaluate(j + d + 1, grids, p, batch);
       };
-      const Choice deeper = expand(deeper_nets, below, cloud, proprio, k);
+      const Choice deeper = expand(deeper_nets, below, cloud, proprio, branching);
       for (int j = 0; j + d + 1 < depths; ++j) {
         c.indices[j + d + 1] = deeper.indices[j];
         c.bounds[j + d + 1] = deeper.bounds[j];

@@ -26,11 +26,11 @@ struct Explored {
   std::vector<bool> replaced;
 };
 
-// `evaluate`, `hierarchy`, `cloud`, `proprio` and `k` are those `chosen` was expanded with:
+// `evaluate`, `hierarchy`, `cloud`, `proprio` and `branching` are those `chosen` was expanded with:
 // the depths below a random voxel are chosen again with them.
 Explored explore(const Choice& chosen, const Exploration& exploration, std::mt19937_64& rng,
                  const DepthEvaluator& evaluate, const voxels::CoarseToFine& hierarchy,
-                 const voxels::PointCloud& cloud, const std::vector<float>& proprio, int k);
+                 const voxels::PointCloud& cloud, const std::vector<float>& proprio, const Branching& branching);
 
 // The same pose and gripper command: the same voxels, rotation bins and gripper_open.
 bool same_action(const Choice& a, const Choice& b);

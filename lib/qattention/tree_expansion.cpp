@@ -18,6 +18,40 @@ std::vector<int> top_k(const float* q, int count, int k) {
   return order;
 }
 
+Branching Branching::within_margin(float margin, int k_max) {
+  Branching b(k_max);
+  b.rule = Rule::margin;
+  b.threshold = margin;
+  return b;
+}
+
+Branching Branching::softmax_mass(float mass, int k_max) {
+  Branching b(k_max);
+  b.rule = Rule::mass;
+  b.threshold = mass;
+  return b;
+}
+
+std::vector<int> branches(const float* q, int count, const Branching& branching) {
+  if (branching.k < 1) throw Error("tree expansion needs k >= 1");
+  std::vector<int> best = top_k(q, count, branching.k);
+  if (branching.rule == Branching::Rule::margin) {
+    std::size_t keep = 1;
+    while (keep < best.size() && q[best[keep]] >= q[best[0]] - branching.threshold) ++keep;
+    best.resize(keep);
+  } else if (branching.rule == Branching::Rule::mass) {
+    // Softmax over the whole volume, shifted by its max (no overflow).
+    double total = 0;
+    for (int i = 0; i < count; ++i) total += std::exp(static_cast<double>(q[i]) - q[best[0]]);
+    std::size_t keep = 0;
+    double held = 0;
+    while (keep < best.size() && (keep == 0 || held < branching.threshold * total))
+      held += std::exp(static_cast<double>(q[best[keep++]]) - q[best[0]]);
+    best.resize(keep);
+  }
+  return best;
+}
+
 namespace {
 
 Eigen::Vector3i unflatten(int flat, int v) { return Eigen::Vector3i(flat / (v * v), (flat / v) % v, flat % v); }
@@ -27,8 +61,8 @@ int argmax(const float* q, int count) { return top_k(q, count, 1)[0]; }
 }  // namespace
 
 Choice expand(const DepthEvaluator& evaluate, const voxels::CoarseToFine& hierarchy,
-              const voxels::PointCloud& cloud, const std::vector<float>& proprio, int k) {
-  return expand_batch(evaluate, hierarchy, {cloud}, {proprio}, k).front();
+              const voxels::PointCloud& cloud, const std::vector<float>& proprio, const Branching& branching) {
+  return expand_batch(evaluate, hierarchy, {cloud}, {proprio}, branching).front();
 }
 
 void check_finite(const nets::QValues& q, int depth) {
@@ -41,14 +75,14 @@ void check_finite(const nets::QValues& q, int depth) {
 
 std::vector<Choice> expand_batch(const DepthEvaluator& evaluate, const voxels::CoarseToFine& hierarchy,
                                  const std::vector<voxels::PointCloud>& clouds,
-                                 const std::vector<std::vector<float>>& proprios, int k) {
-  return expand_batch(evaluate, nullptr, hierarchy, clouds, proprios, k);
+                                 const std::vector<std::vector<float>>& proprios, const Branching& branching) {
+  return expand_batch(evaluate, nullptr, hierarchy, clouds, proprios, branching);
 }
 
 std::vector<Choice> expand_batch(const DepthEvaluator& rank, const DepthEvaluator& value_of,
                                  const voxels::CoarseToFine& hierarchy, const std::vector<voxels::PointCloud>& clouds,
-                                 const std::vector<std::vector<float>>& proprios, int k) {
-  if (k < 1) throw Error("tree expansion needs k >= 1");
+                                 const std::vector<std::vector<float>>& proprios, const Branching& branching) {
+  if (branching.k < 1) throw Error("tree expansion needs k >= 1");
   if (clouds.size() != proprios.size() || clouds.empty())
     throw Error("tree expansion needs one proprio vector per point cloud");
   const int depths = hierarchy.depths, v = hierarchy.voxels(), cells = v * v * v;
@@ -94,7 +128,7 @@ std::vector<Choice> expand_batch(const DepthEvaluator& rank, const DepthEvaluato
     expanded_grids += n;
     if (d + 1 == depths) break;
     for (int i = 0; i < n; ++i)
-      for (int flat : top_k(ranked[d].translation.data() + static_cast<std::size_t>(i) * cells, cells, k))
+      for (int flat : branches(ranked[d].translation.data() + static_cast<std::size_t>(i) * cells, cells, branching))
         levels[d + 1].push_back({hierarchy.bounds_at(d + 1, level[i].bounds.centre_of(unflatten(flat, v))),
                                  level[i].observation, i, flat});
   }
@@ -128,6 +162,10 @@ std::vector<Choice> expand_batch(const DepthEvaluator& rank, const DepthEvaluato
   for (std::size_t root = 0; root < clouds.size(); ++root) {
     Choice& choice = choices[root];
     choice.expanded_grids = expanded_grids;
+    for (int d = 1; d < depths; ++d)
+      choice.branches.push_back(static_cast<int>(std::count_if(levels[d].begin(), levels[d].end(), [&](const Node& n) {
+        return n.observation == static_cast<int>(root);
+      })));
     int node = static_cast<int>(root);
     choice.value = value[0][node];
     for (int d = 0; d < depths; ++d) {

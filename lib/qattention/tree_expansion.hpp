@@ -25,6 +25,24 @@ namespace qte::qattention {
 using DepthEvaluator =
     std::function<nets::QValues(int depth, const float* grids, const float* proprio, int batch)>;
 
+// How many of a node's voxels become branches. Fixed: the K best (K = 1: greedy). Adaptive
+// (the paper's open question of choosing K): the node's own Q volume decides, expanding more
+// where it is unsure — every voxel within `margin` of its best Q, or the fewest best voxels
+// holding `mass` of its softmax — at least 1, at most `k` (then K_max).
+struct Branching {
+  enum class Rule { fixed, margin, mass };
+  Rule rule = Rule::fixed;
+  int k = 1;
+  float threshold = 0;  // margin: Q units; mass: a share in (0, 1]
+  Branching(int fixed_k = 1) : k(fixed_k) {}  // NOLINT: an int is a fixed K
+  static Branching within_margin(float margin, int k_max);
+  static Branching softmax_mass(float mass, int k_max);
+  bool adaptive() const { return rule != Rule::fixed; }
+};
+
+// The branches of one Q volume (flat indices, best first, ties to the lower index).
+std::vector<int> branches(const float* q, int count, const Branching& branching);
+
 struct Choice {
   std::vector<Eigen::Vector3i> indices;       // per depth
   std::vector<voxels::GridBounds> bounds;     // per depth
@@ -34,7 +52,8 @@ struct Choice {
   bool gripper_open = true;
   Eigen::Vector3f rotation_q = Eigen::Vector3f::Zero();  // the chosen bins' Q values
   float gripper_q = 0;                                   // the chosen gripper action's Q value
-  int expanded_grids = 0;                     // grids evaluated (1 + K + K^2 + ...)
+  int expanded_grids = 0;                     // grids evaluated, all observations (1 + K + K^2 + ...)
+  std::vector<int> branches;                  // per non-leaf depth: this tree's nodes expanded there
   Eigen::Vector3d position() const { return bounds.back().centre_of(indices.back()); }
 };
 
@@ -44,23 +63,24 @@ inline float branch_value(float q, float deeper_value) { return (q + deeper_valu
 // The K best voxels of one Q volume (flat indices, best first, ties to the lower index).
 std::vector<int> top_k(const float* q, int count, int k);
 
-// `k` branches per non-leaf depth (k = 1: greedy). The last depth's gripper Q values are
-// (close, open), as the transitions' gripper_open 0 / 1.
+// Branches per non-leaf grid as `branching` says (k = 1: greedy). The last depth's gripper Q
+// values are (close, open), as the transitions' gripper_open 0 / 1.
 Choice expand(const DepthEvaluator& evaluate, const voxels::CoarseToFine& hierarchy,
-              const voxels::PointCloud& cloud, const std::vector<float>& proprio, int k);
+              const voxels::PointCloud& cloud, const std::vector<float>& proprio, const Branching& branching);
 
 // Tree expansion of several observations at once (the learner's bootstrap targets): every
-// depth's grids of all of them go through one batched forward. `proprios[i]` belongs to
-// `clouds[i]`; the choices come back in the same order.
+// depth's grids of all of them go through one batched forward (packed: with an adaptive rule
+// trees expand different numbers of branches, and a level holds just the nodes there are).
+// `proprios[i]` belongs to `clouds[i]`; the choices come back in the same order.
 std::vector<Choice> expand_batch(const DepthEvaluator& evaluate, const voxels::CoarseToFine& hierarchy,
                                  const std::vector<voxels::PointCloud>& clouds,
-                                 const std::vector<std::vector<float>>& proprios, int k);
+                                 const std::vector<std::vector<float>>& proprios, const Branching& branching);
 
 // The same with indices from `rank` (the online networks) and values from `value` (the target
 // networks), both evaluated on the grids `rank`'s choices lead to: the published target.
 std::vector<Choice> expand_batch(const DepthEvaluator& rank, const DepthEvaluator& value,
                                  const voxels::CoarseToFine& hierarchy, const std::vector<voxels::PointCloud>& clouds,
-                                 const std::vector<std::vector<float>>& proprios, int k);
+                                 const std::vector<std::vector<float>>& proprios, const Branching& branching);
 
 // Throws Error when a network's output holds NaN or infinity (a diverged checkpoint, or a
 // non-finite input that reached the network): a max over NaN picks nothing.

@@ -28,6 +28,7 @@ std::unique_ptr<btConvexHullShape> make_hull(const std::vector<Eigen::Vector3d>&
   auto hull = std::make_unique<btConvexHullShape>();
   for (const auto& p : points) hull->addPoint(btVector3(p.x(), p.y(), p.z()), false);
   hull->setMargin(kHullMargin);
+  hull->initializePolyhedralFeatures();  // faces for SAT and clipping: flat hulls rest flat on each other
   hull->recalcLocalAabb();  // after the margin: the cached box includes it (default 4 cm)
   return hull;
 }
@@ -123,6 +124,9 @@ World::World(const robot::RobotModel& robot, const SceneLayout& layout)
     : impl_(std::make_unique<Impl>()), robot_(robot), layout_(layout) {
   auto& w = impl_->world;
   w.setGravity(btVector3(0, 0, -9.81));
+  // Hull pairs by separating axes and face clipping (several contact points per face) rather
+  // than GJK's one point a step: stacked thin hulls (checkers) otherwise sink into each other.
+  w.getDispatchInfo().m_enableSatConvex = true;
 
   render::Appearance wood, ground;
   wood.colour << 0.72f, 0.56f, 0.40f;

@@ -16,9 +16,10 @@ class btCollisionWorld;
 
 namespace qte::sim {
 
-// Bullet's collision margin around convex hulls (and compounds of them): a hull rests this
-// far above what it stands on, and two stacked hulls twice this apart. Cameras see the hull
-// itself. Spawn resting hulls this high, or they start interpenetrating and jump.
+// Bullet's collision margin around convex hulls (and compounds of them): a hull rests up to
+// this far above what it stands on (cameras see the hull itself). Spawn resting hulls this
+// high above their support, one margin each side when stacked (they drop a millimetre at
+// most), never lower: hulls that start interpenetrating jump.
 constexpr double kHullMargin = 0.001;
 
 struct ObjectSpec {

@@ -49,7 +49,7 @@ records = list(read_records(path))
 fields = ["pose", "gripper_open", "ignore_collisions"]
 for d in range(2):
     fields += [f"depth{d}.index", f"depth{d}.bounds", f"depth{d}.centre", f"depth{d}.q_value"]
-fields += ["rotation_bins", "value", "k", "explored", "checkpoint_step", "step"]
+fields += ["rotation_bins", "value", "k", "branches", "explored", "checkpoint_step", "step"]
 def bad(i, what):
     sys.exit(f"{path}: record {i}: {what}")
 def rotation(bins):  # Euler 'xyz': R = Rz(c) Ry(b) Rx(a), angle = bin * 5 - 180 degrees
@@ -84,6 +84,8 @@ for i, r in enumerate(records):
         bad(i, f"quaternion {pose[3:]} is not the rotation of bins {bins}")
     if int(a["step"]) != int(f["step"]) or int(a["k"]) != k or int(a["checkpoint_step"]) != 0:
         bad(i, "step, k or checkpoint_step")
+    if list(a["branches"]) != [k]:  # a fixed K expands K grids at depth 1, explored or not
+        bad(i, f"branches {list(a['branches'])}")
     if int(a["gripper_open"]) not in (0, 1) or int(a["ignore_collisions"]) != 0:
         bad(i, "gripper_open or ignore_collisions")
     if explored != "any" and int(a["explored"]) != int(explored):
@@ -131,6 +133,29 @@ check "$tmp/k1.rec" 1 0
 value() { stream-dump --json --type action "$1" | grep -o '"name":"value","dtype":"float32","shape":\[\],"values":\[[^]]*' | grep -o '[^[]*$'; }
 paste -d' ' <(value "$tmp/k1.rec") <(value "$tmp/greedy.rec") | awk '$2 < $1 - 1e-5 { bad = 1 } END { exit bad }' \
   || fail "a K = 10 value below the greedy one: $(paste -d' ' <(value "$tmp/k1.rec") <(value "$tmp/greedy.rec") | tr '\n' ';')"
+
+# --k auto: a margin wider than any Q range is K = --k-max (the same bytes as --k 10); margin 0
+# is the greedy choice (the poses of --k 1, one branch); in between, 1 to K_max per action.
+qte-select --checkpoint "$ckpt" --k auto --k-margin 1e9 --k-max 10 --seed 5 "$tmp/in.rec" | cmp -s - "$tmp/greedy.rec" \
+  || fail "--k auto with an unbounded margin differs from --k 10"
+qte-select --checkpoint "$ckpt" --k auto --k-margin 0 "$tmp/in.rec" > "$tmp/auto0.rec" || fail "--k auto exit $?"
+qte-select --checkpoint "$ckpt" --k auto --k-mass 0.5 --k-max 4 "$tmp/in.rec" > "$tmp/mass.rec" || fail "--k-mass exit $?"
+$py - "$src/examples" "$tmp/greedy.rec" "$tmp/k1.rec" "$tmp/auto0.rec" "$tmp/mass.rec" <<'EOF2' || fail "--k auto's branches"
+import sys
+import numpy as np
+sys.path.insert(0, sys.argv[1])
+from read_stream import read_records
+actions = [[r for r in read_records(path) if r.type == "action"] for path in sys.argv[2:]]
+greedy, k1, auto0, mass = actions
+assert all(list(a.fields["branches"]) == [10] for a in greedy), "--k 10 expands 10 at depth 1"
+for a, b in zip(k1, auto0):
+    assert list(b.fields["branches"]) == [1], "margin 0: one branch"
+    assert np.array_equal(a.fields["pose"], b.fields["pose"]), "margin 0: the greedy pose"
+assert all(1 <= int(a.fields["branches"][0]) <= 4 for a in mass), "--k-max 4 bounds the branches"
+EOF2
+# Without auto, the rule's options are refused; auto needs a rule.
+qte-select --checkpoint "$ckpt" --k 3 --k-margin 1 "$tmp/in.rec" > /dev/null 2>&1 && fail "--k-margin without auto accepted"
+qte-select --checkpoint "$ckpt" --k auto "$tmp/in.rec" > /dev/null 2>&1 && fail "--k auto without a rule accepted"
 
 # --ignore-collisions and --png.
 first_obs() { stream-cat --type obs --head 1 "$tmp/episodes.rec"; }

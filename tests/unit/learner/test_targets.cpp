@@ -154,3 +154,25 @@ TEST(BootstrapTargets, TreeTargetOneIsAlgorithmTwoWithKOne) {
   }
   EXPECT_FLOAT_EQ(t.translation[0][2], 1.0f);  // terminal: the scaled reward alone
 }
+
+// An adaptive tree target (--tree-target auto): with a margin no volume exceeds it is the
+// fixed-K target, and it reports K branches; with margin 0 it is the K = 1 tree (one branch).
+TEST(BootstrapTargets, AdaptiveTreeTargetBetweenKOneAndKMax) {
+  const DepthEvaluator online = test_support::content_q(0.0f), target = test_support::content_q(1.3f);
+  Case fixed(2, 3), open(2, 3), k1(2, 1), closed(2, 3);
+  open.config.tree_branching = Branching::within_margin(std::numeric_limits<float>::infinity(), 3);
+  closed.config.tree_branching = Branching::within_margin(0.0f, 3);
+  const learner::Targets want = learner::bootstrap_targets(online, target, fixed.config, fixed.batch);
+  const learner::Targets got = learner::bootstrap_targets(online, target, open.config, open.batch);
+  EXPECT_EQ(got.translation, want.translation);
+  EXPECT_EQ(got.rotation, want.rotation);
+  EXPECT_EQ(got.mean_branches, std::vector<double>{3.0});
+  EXPECT_EQ(want.mean_branches, std::vector<double>{3.0});
+  const learner::Targets one = learner::bootstrap_targets(online, target, k1.config, k1.batch);
+  const learner::Targets zero = learner::bootstrap_targets(online, target, closed.config, closed.batch);
+  EXPECT_EQ(zero.translation, one.translation);
+  EXPECT_EQ(zero.mean_branches, std::vector<double>{1.0});
+  // K = 0 (double DQN) has no tree to report.
+  Case none(2, 0);
+  EXPECT_TRUE(learner::bootstrap_targets(online, target, none.config, none.batch).mean_branches.empty());
+}

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <set>
 
 #include "common/error.hpp"
 #include "qattention/tree_expansion.hpp"
@@ -394,4 +395,96 @@ TEST(TreeExpansion, NonFiniteQValuesAreAnError) {
       }
     }
   }
+}
+
+// Adaptive branching (issue 16): a node expands as many voxels as its own Q volume is unsure
+// about, within [1, K_max].
+TEST(Branching, OneClearWinnerExpandsOneBranch) {
+  std::vector<float> q(kCells, 0.0f);
+  q[7] = 5.0f;
+  EXPECT_EQ(branches(q.data(), kCells, Branching::within_margin(1.0f, 10)), std::vector<int>{7});
+  const float small[8] = {0, 5, 0, 0, 0, 0, 0, 0};  // softmax: 0.955 on voxel 1
+  EXPECT_EQ(branches(small, 8, Branching::softmax_mass(0.9f, 10)), std::vector<int>{1});
+}
+
+TEST(Branching, ThreeNearEqualVoxelsExpandThree) {
+  const float q[8] = {4.9f, 0, 5.0f, 0, 4.95f, 0, 0, 0};
+  EXPECT_EQ(branches(q, 8, Branching::within_margin(0.2f, 10)), (std::vector<int>{2, 4, 0}));
+  // Softmax: the three hold 0.989 of the mass, the best two 0.66.
+  EXPECT_EQ(branches(q, 8, Branching::softmax_mass(0.95f, 10)), (std::vector<int>{2, 4, 0}));
+  EXPECT_EQ(branches(q, 8, Branching::softmax_mass(0.6f, 10)), (std::vector<int>{2, 4}));
+}
+
+TEST(Branching, BoundsOnKAreKept) {
+  const float q[8] = {4.9f, 0, 5.0f, 0, 4.95f, 0, 0, 0};
+  EXPECT_EQ(branches(q, 8, Branching::within_margin(0.2f, 2)), (std::vector<int>{2, 4}));     // at most K_max
+  EXPECT_EQ(branches(q, 8, Branching::within_margin(100.0f, 5)).size(), 5u);                  // everything: K_max
+  EXPECT_EQ(branches(q, 8, Branching::within_margin(0.0f, 5)), std::vector<int>{2});          // at least 1
+  EXPECT_EQ(branches(q, 8, Branching::softmax_mass(1e-9f, 5)), std::vector<int>{2});
+  EXPECT_EQ(branches(q, 8, Branching::softmax_mass(1.0f, 20)).size(), 8u);                    // no more than there are
+  EXPECT_EQ(branches(q, 8, Branching(3)), top_k(q, 8, 3));                                    // fixed K: top-K
+  EXPECT_THROW(branches(q, 8, Branching::within_margin(1.0f, 0)), Error);
+}
+
+// A margin no Q volume can exceed is fixed K: the same choice, the same grids, and the
+// branches per depth K, K^2.
+TEST(Branching, WithTheRuleOffTreeExpansionIsFixedK) {
+  const Cloud cloud;
+  const std::vector<float> proprio = {1, 0.04f, 0.04f, 0.5f};
+  for (int depths : {2, 3}) {
+    voxels::CoarseToFine hierarchy;
+    hierarchy.depths = depths;
+    hierarchy.offsets_m.assign(depths - 1, 0.15);
+    for (int k : {1, 3}) {
+      const Choice fixed = expand(test_support::content_q(), hierarchy, cloud.view(), proprio, k);
+      const Choice open = expand(test_support::content_q(), hierarchy, cloud.view(), proprio,
+                                 Branching::within_margin(std::numeric_limits<float>::infinity(), k));
+      EXPECT_EQ(open.indices, fixed.indices);
+      EXPECT_EQ(open.q_values, fixed.q_values);
+      EXPECT_EQ(open.value, fixed.value);
+      EXPECT_EQ(open.expanded_grids, fixed.expanded_grids);
+      std::vector<int> expected;
+      for (int d = 1, width = k; d < depths; ++d, width *= k) expected.push_back(width);
+      EXPECT_EQ(fixed.branches, expected);
+      EXPECT_EQ(open.branches, expected);
+    }
+  }
+}
+
+// Trees of one batch that expand different numbers of branches still go through one forward
+// per depth (packed), and each chooses what it chooses alone.
+TEST(Branching, AdaptiveTreesOfOneBatchChooseAsAlone) {
+  const float kMargin = 0.01f;  // content_q's volumes are dense near their best: 10, 10 and 6 within it
+  const voxels::CoarseToFine hierarchy;
+  std::vector<test_support::RandomCloud> clouds;
+  for (uint32_t seed : {1u, 2u, 3u}) clouds.emplace_back(seed, std::array<uint8_t, 3>{120, 80, 40});
+  std::vector<voxels::PointCloud> views;
+  for (const auto& c : clouds) views.push_back(c.view());
+  const std::vector<std::vector<float>> proprios(3, std::vector<float>{1, 0.04f, 0.04f, 0.5f});
+  const Branching adaptive = Branching::within_margin(kMargin, 10);
+  int calls = 0;
+  const DepthEvaluator counted = [&](int depth, const float* grids, const float* p, int batch) {
+    calls += 1;
+    return test_support::content_q()(depth, grids, p, batch);
+  };
+  const auto together = expand_batch(counted, hierarchy, views, proprios, adaptive);
+  EXPECT_EQ(calls, 2);
+  std::set<int> counts;
+  for (int i = 0; i < 3; ++i) {
+    const Choice alone = expand(test_support::content_q(), hierarchy, views[i], proprios[i], adaptive);
+    EXPECT_EQ(together[i].indices, alone.indices) << i;
+    EXPECT_EQ(together[i].value, alone.value) << i;
+    EXPECT_EQ(together[i].branches, alone.branches) << i;
+    // Depth 0's branches: the voxels of its volume within the margin, counted here directly.
+    std::vector<float> grid(static_cast<std::size_t>(kCells) * voxels::kChannels);
+    voxels::voxelize(views[i], hierarchy.scene, grid.data());
+    const nets::QValues q0 = test_support::content_q()(0, grid.data(), proprios[i].data(), 1);
+    const float best = *std::max_element(q0.translation.begin(), q0.translation.end());
+    const int within = static_cast<int>(std::count_if(q0.translation.begin(), q0.translation.end(),
+                                                      [&](float x) { return x >= best - kMargin; }));
+    EXPECT_EQ(alone.branches[0], std::clamp(within, 1, 10)) << i;
+    counts.insert(alone.branches[0]);
+  }
+  EXPECT_EQ(together[0].expanded_grids, 3 + together[0].branches[0] + together[1].branches[0] + together[2].branches[0]);
+  EXPECT_GT(counts.size(), 1u) << "the three scenes should need different numbers of branches";
 }
