@@ -1,11 +1,13 @@
 #!/usr/bin/env python3
 """Final success per method over seeds, from learn.sh's eval.csv files (one per run).
 
-    results_table.py [--markdown] RUN.csv...
+    results_table.py [--markdown | --finals] RUN.csv...
 
-One row per label (method): the runs' final evaluations (the last eval_point of each run),
-their mean and sample standard deviation, each run's successes with its Wilson 95% interval,
-and the mean training wall-clock (train_s) where the CSVs have it. Standard library only.
+One row per label (method): the runs' final evaluations (the last eval_point of each run):
+the environment and learner steps they had taken (means), their success's mean and sample
+standard deviation, each run's successes with its Wilson 95% interval,
+and the mean training wall-clock (train_s) where the CSVs have it. --finals prints each run's
+final row instead (for a picture of final success per seed). Standard library only.
 """
 import argparse
 import csv
@@ -15,7 +17,7 @@ from collections import defaultdict
 
 
 def final_rows(paths):
-    runs = defaultdict(list)  # label -> final row of each run
+    runs = defaultdict(list)  # label -> final row of each run, in the order given
     for path in paths:
         with open(path, newline="") as f:
             rows = list(csv.DictReader(f))
@@ -35,7 +37,8 @@ def summary(label, rows):
     return {
         "label": label,
         "runs": len(rows),
-        "eval_point": rows[0]["eval_point"],
+        "env_steps": f"{statistics.mean(float(r['env_steps']) for r in rows):.0f}",
+        "learner_steps": f"{statistics.mean(float(r['train_step']) for r in rows):.0f}",
         "mean_success": f"{statistics.mean(rates):.3f}",
         "std_success": f"{statistics.stdev(rates):.3f}" if len(rates) > 1 else "",
         "mean_train_min": f"{statistics.mean(times) / 60:.1f}" if times else "",
@@ -46,9 +49,17 @@ def summary(label, rows):
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--markdown", action="store_true", help="a Markdown table instead of CSV")
+    parser.add_argument("--finals", action="store_true", help="each run's final row, as CSV")
     parser.add_argument("runs", nargs="+")
     args = parser.parse_args()
-    table = [summary(label, rows) for label, rows in sorted(final_rows(args.runs).items())]
+    runs = final_rows(args.runs)
+    if args.finals:
+        rows = [row for label in sorted(runs) for row in sorted(runs[label], key=lambda r: int(r["seed"]))]
+        writer = csv.DictWriter(sys.stdout, fieldnames=list(rows[0].keys()), lineterminator="\n")
+        writer.writeheader()
+        writer.writerows(rows)
+        return
+    table = [summary(label, rows) for label, rows in sorted(runs.items())]
     columns = list(table[0].keys())
     if args.markdown:
         print("| " + " | ".join(columns) + " |")

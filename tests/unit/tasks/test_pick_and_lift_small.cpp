@@ -8,10 +8,8 @@
 #include <cmath>
 
 #include "render/ray_caster.hpp"
-#include "simulator/trajectory_helpers.hpp"
 #include "tasks/shapes.hpp"
-#include "tasks/task.hpp"
-#include "test_support.hpp"
+#include "task_scene.hpp"
 
 using namespace qte;
 
@@ -20,14 +18,8 @@ namespace {
 const char* const kShapes[] = {"cube", "cylinder", "triangular_prism", "star", "moon"};
 constexpr double kSize = 0.0209;
 
-struct Scene {
-  sim::World world{test_support::xarm()};
-  std::unique_ptr<tasks::Task> task = tasks::make_task("pick_and_lift_small");
-  Scene(uint64_t seed, int variation) {
-    std::mt19937_64 rng(seed);
-    task->build(world, variation, rng);
-  }
-  Eigen::Isometry3d pose(const std::string& name) const { return world.object_pose(world.object_id(name)); }
+struct Scene : test_support::TaskScene {
+  Scene(uint64_t seed, int variation) : TaskScene("pick_and_lift_small", seed, variation) {}
 };
 
 double area(const tasks::Polygon& p) {  // shoelace

@@ -2,22 +2,14 @@
 // apart, each within one depth-0 voxel's width), when it is solved, and that a seed decides it.
 #include <gtest/gtest.h>
 
-#include "tasks/task.hpp"
-#include "simulator/trajectory_helpers.hpp"
-#include "test_support.hpp"
+#include "task_scene.hpp"
 
 using namespace qte;
 
 namespace {
 
-struct Scene {
-  sim::World world{test_support::xarm()};
-  std::unique_ptr<tasks::Task> task = tasks::make_task("reach_prism");
-  explicit Scene(uint64_t seed) {
-    std::mt19937_64 rng(seed);
-    task->build(world, 0, rng);
-  }
-  Eigen::Isometry3d pose(const std::string& name) const { return world.object_pose(world.object_id(name)); }
+struct Scene : test_support::TaskScene {
+  explicit Scene(uint64_t seed) : TaskScene("reach_prism", seed, 0) {}
 };
 
 const char* const kObjects[] = {"prism", "triangular_prism", "cube"};

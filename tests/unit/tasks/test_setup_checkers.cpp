@@ -4,9 +4,7 @@
 // from the rules of the game (red on the dark squares of rows 0-2, black of rows 5-7).
 #include <gtest/gtest.h>
 
-#include "simulator/trajectory_helpers.hpp"
-#include "tasks/task.hpp"
-#include "test_support.hpp"
+#include "task_scene.hpp"
 
 using namespace qte;
 
@@ -14,14 +12,8 @@ namespace {
 
 constexpr double kSquare = 0.04, kCheckerHeight = 0.0072;
 
-struct Scene {
-  sim::World world{test_support::xarm()};
-  std::unique_ptr<tasks::Task> task = tasks::make_task("setup_checkers");
-  Scene(uint64_t seed, int variation) {
-    std::mt19937_64 rng(seed);
-    task->build(world, variation, rng);
-  }
-  Eigen::Isometry3d pose(const std::string& name) const { return world.object_pose(world.object_id(name)); }
+struct Scene : test_support::TaskScene {
+  Scene(uint64_t seed, int variation) : TaskScene("setup_checkers", seed, variation) {}
   Eigen::Isometry3d board() const { return pose("board"); }
 
   // The k-th dark square (row + column even) of the side's home rows, as the checker rests on it.
@@ -50,21 +42,10 @@ struct Scene {
     });
     return off;
   }
-  // Grasp from above, carry to `to` + 5 mm, and (unless told not to) open and let it settle.
+  // Grasped and placed square to the board (as the expert does).
   void place(const std::string& name, const Eigen::Vector3d& to, bool release = true) {
     const double yaw = std::atan2(board().linear()(1, 0), board().linear()(0, 0));
-    Eigen::Isometry3d tcp = Eigen::Isometry3d::Identity();
-    tcp.linear() = tasks::top_down(yaw);
-    tcp.translation() = pose(name).translation();
-    world.set_robot_state(test_support::ik_world(world, tcp), 0.085);
-    ASSERT_EQ(world.close_gripper(), world.object_id(name));
-    tcp.translation() = to + Eigen::Vector3d(0, 0, 0.005);
-    world.set_robot_state(test_support::ik_world(world, tcp), world.finger_opening_m());
-    if (!release) return;
-    world.open_gripper();
-    world.settle(0.5);
-    tcp.translation().z() += 0.1;
-    world.set_robot_state(test_support::ik_world(world, tcp), 0.085);
+    TaskScene::place(name, yaw, to, yaw, release);
   }
 };
 

@@ -4,9 +4,7 @@
 // no); a seed decides the scene.
 #include <gtest/gtest.h>
 
-#include "simulator/trajectory_helpers.hpp"
-#include "tasks/task.hpp"
-#include "test_support.hpp"
+#include "task_scene.hpp"
 
 using namespace qte;
 
@@ -14,35 +12,13 @@ namespace {
 
 constexpr double kBlock = 0.05;
 
-struct Scene {
-  sim::World world{test_support::xarm()};
-  std::unique_ptr<tasks::Task> task = tasks::make_task("stack_blocks");
-  Scene(uint64_t seed, int variation) {
-    std::mt19937_64 rng(seed);
-    task->build(world, variation, rng);
-  }
-  Eigen::Isometry3d pose(const std::string& name) const { return world.object_pose(world.object_id(name)); }
+struct Scene : test_support::TaskScene {
+  Scene(uint64_t seed, int variation) : TaskScene("stack_blocks", seed, variation) {}
   Eigen::Vector3d plane() const { return pose("target_plane").translation(); }
-
-  // Grasps `name` from above, carries it to `to` (its centre, 5 mm above where it rests),
-  // opens and lets it settle: what the expert's place does, without the planner.
+  // Grasped square to its faces, placed square to the world (as the expert does).
   void place(const std::string& name, const Eigen::Vector3d& to, bool release = true) {
-    Eigen::Isometry3d grasp = Eigen::Isometry3d::Identity();
     const Eigen::Vector3d x_axis = pose(name).linear().col(0);
-    grasp.linear() = tasks::top_down(std::remainder(std::atan2(x_axis.y(), x_axis.x()), M_PI / 2));
-    grasp.translation() = pose(name).translation();
-    world.set_robot_state(test_support::ik_world(world, grasp), 0.085);
-    ASSERT_EQ(world.close_gripper(), world.object_id(name));
-    Eigen::Isometry3d over = Eigen::Isometry3d::Identity();
-    over.linear() = tasks::top_down(0);
-    over.translation() = to + Eigen::Vector3d(0, 0, 0.005);
-    world.set_robot_state(test_support::ik_world(world, over), world.finger_opening_m());
-    if (!release) return;
-    world.open_gripper();
-    world.settle(0.5);
-    // Out of the way, up and open.
-    over.translation().z() += 0.15;
-    world.set_robot_state(test_support::ik_world(world, over), 0.085);
+    TaskScene::place(name, std::remainder(std::atan2(x_axis.y(), x_axis.x()), M_PI / 2), to, 0, release);
   }
   Eigen::Vector3d level(int k) const {
     return plane() + Eigen::Vector3d(0, 0, kBlock / 2 + k * kBlock - 0.001);  // the plane's centre is 1 mm up
