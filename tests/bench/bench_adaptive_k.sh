@@ -3,15 +3,22 @@
 # observations of 5 recorded expert demonstrations (held-out scenes), one thread, with a trained
 # checkpoint — per setting the seconds per observation, the mean grids expanded at depth 1,
 # and how often the chosen voxel differs from K = 10's.
-# Usage: bench_adaptive_k CHECKPOINT [TASK] [IMAGE] [TOOLS_DIR]
-#        (a checkpoint of TASK, e.g. a learn.sh run's ckpt/latest.rec; defaults reach_prism,
-#        256x256, the build's tools)
+# Usage: bench_adaptive_k [CHECKPOINT] [TASK] [IMAGE] [TOOLS_DIR]
+#        (a checkpoint of TASK, e.g. a learn.sh run's ckpt/latest.rec; without one (or with
+#        '-'), networks trained for 150 steps on 3 demonstrations, whose Q volumes say little;
+#        defaults reach_prism, 256x256, the build's tools)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
-checkpoint=${1:?usage: bench_adaptive_k CHECKPOINT [TASK] [IMAGE] [TOOLS_DIR]}
-task=${2:-reach_prism} image=${3:-256x256} tools=${4:-$here/../../tools}
+checkpoint=${1:--} task=${2:-reach_prism} image=${3:-256x256} tools=${4:-$here/../../tools}
 export PATH=$tools:$PATH
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+if [ "$checkpoint" = - ]; then
+  demo-record --task "$task" --episodes 3 --seed 1 --image-size "$image" --output "$tmp/train.rec" 2>/dev/null
+  keyframe --output "$tmp/replay.rec" "$tmp/train.rec" 2>/dev/null
+  qattn-train --steps 150 --start-after 0 --checkpoint-every 150 --seed 1 --threads 2 --checkpoint-dir "$tmp/ckpt" \
+    "$tmp/replay.rec" 2>/dev/null
+  checkpoint=$tmp/ckpt/latest.rec
+fi
 
 demo-record --task "$task" --episodes 5 --seed 3 --scenes eval --image-size "$image" --output "$tmp/demo.rec" 2>/dev/null
 # Every observation of the demonstrations (qte-select acts on each).
