@@ -53,12 +53,19 @@ static void run(const cli::Arguments& args) {
       for (const auto& field : record->fields()) {
         const auto& shape = field.shape();
         const std::string path = dir + "/" + index + "." + field.name() + ".png";
-        if (stream::ends_with(field.name(), ".rgb") && field.dtype() == stream::DType::u8 && shape.size() == 3 && shape[2] == 3) {
+        const bool rgb = stream::ends_with(field.name(), ".rgb");
+        const bool depth = args.flag("depth") && stream::ends_with(field.name(), ".depth");
+        // An image field that is not one, or empty, is the input's fault: name the record.
+        if (rgb && !(field.dtype() == stream::DType::u8 && shape.size() == 3 && shape[2] == 3))
+          record->fail(field.name(), "an RGB image (uint8, height x width x 3)");
+        if (depth && !(field.dtype() == stream::DType::f32 && shape.size() == 2))
+          record->fail(field.name(), "a depth image (float32, height x width)");
+        if ((rgb || depth) && (shape[0] == 0 || shape[1] == 0)) record->fail(field.name(), "a non-empty image");
+        if (rgb) {
           const cv::Mat rgb(static_cast<int>(shape[0]), static_cast<int>(shape[1]), CV_8UC3,
                             const_cast<uint8_t*>(field.bytes()));
           render::save_rgb_png(path, rgb);
-        } else if (args.flag("depth") && stream::ends_with(field.name(), ".depth") &&
-                   field.dtype() == stream::DType::f32 && shape.size() == 2) {
+        } else if (depth) {
           const cv::Mat depth(static_cast<int>(shape[0]), static_cast<int>(shape[1]), CV_32FC1,
                               const_cast<uint8_t*>(field.bytes()));
           render::save_depth_png(path, depth);

@@ -16,6 +16,13 @@ stream-pack reset task=lift_numbered_block variation:i32=2 seed:i64=1 | sim-step
 file "$tmp/png/000000.front.rgb.png" 2>/dev/null | grep -q "96 x 96" || [ -s "$tmp/png/000000.front.rgb.png" ] \
   || fail "no PNG written"
 [ -s "$tmp/png/000000.front.depth.png" ] || fail "no depth PNG"
+# stream-png: an image field that is empty or not an image names the record and field, exit 1.
+for bad in "front.rgb:u8[0,4,3]=" "front.rgb:u8[2,2]=1,2,3,4" "front.depth:f32[0,3]="; do
+  err=$(stream-pack obs "$bad" | stream-png --depth --dir "$tmp/badpng" 2>&1); rc=$?
+  [ $rc = 1 ] && grep -q "<stdin>: record 0 at byte 0: 'obs' record, field 'front\.\(rgb\|depth\)': expected" <<<"$err" \
+    || fail "stream-png on $bad: exit $rc: $err"
+done
+[ -z "$(ls "$tmp/badpng" 2>/dev/null)" ] || fail "stream-png wrote a PNG of a bad image"
 
 # Unknown task: one line listing the tasks, exit 1, nothing written.
 err=$(sim-step --task open_drawer --output "$tmp/x.rec" < /dev/null 2>&1 >/dev/null); rc=$?
