@@ -157,15 +157,15 @@ std::vector<Choice> expand_batch(const DepthEvaluator& rank, const DepthEvaluato
       }
     }
   }
-  // Follow each tree's best path from its root.
+  // Follow each tree's best path from its root; count its nodes per depth below the root.
   std::vector<Choice> choices(clouds.size());
+  for (int d = 1; d < depths; ++d) {
+    for (Choice& c : choices) c.branches.push_back(0);
+    for (const Node& node : levels[d]) choices[node.observation].branches.back() += 1;
+  }
   for (std::size_t root = 0; root < clouds.size(); ++root) {
     Choice& choice = choices[root];
     choice.expanded_grids = expanded_grids;
-    for (int d = 1; d < depths; ++d)
-      choice.branches.push_back(static_cast<int>(std::count_if(levels[d].begin(), levels[d].end(), [&](const Node& n) {
-        return n.observation == static_cast<int>(root);
-      })));
     int node = static_cast<int>(root);
     choice.value = value[0][node];
     for (int d = 0; d < depths; ++d) {

@@ -35,6 +35,16 @@ std::vector<Waypoint> grasp_and_lift(const sim::World& world, int block_id, doub
   return {above, grasp, lift};
 }
 
+std::vector<Waypoint> place_at(const Eigen::Vector3d& resting_centre, double yaw_rad, double above_m) {
+  Waypoint over, place, retreat;
+  over.tcp_pose.linear() = place.tcp_pose.linear() = retreat.tcp_pose.linear() = top_down(yaw_rad);
+  place.tcp_pose.translation() = resting_centre + Eigen::Vector3d(0, 0, 0.005);
+  over.tcp_pose.translation() = retreat.tcp_pose.translation() = place.tcp_pose.translation() + Eigen::Vector3d(0, 0, above_m);
+  over.gripper_open = false;
+  place.ignore_collisions = retreat.ignore_collisions = true;  // the held object meets what it goes on
+  return {over, place, retreat};  // place.gripper_open: opened on arrival
+}
+
 sim::ObjectSpec success_zone(const sim::World& world, const Eigen::Vector3d& xy, double radius) {
   sim::ObjectSpec zone;
   zone.name = "success_zone";

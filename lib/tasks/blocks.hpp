@@ -16,6 +16,11 @@ sim::ObjectSpec block(const sim::World& world, const std::string& name, const Ei
 // `lift_m`: the first three waypoints of every pick task.
 std::vector<Waypoint> grasp_and_lift(const sim::World& world, int block_id, double lift_m);
 
+// Placing the held object: over `resting_centre` (where its centre will rest) by `above_m`,
+// down to 5 mm over it, the gripper opening there (released; physics settles it), back up;
+// the fingers closing along world yaw `yaw_rad`.
+std::vector<Waypoint> place_at(const Eigen::Vector3d& resting_centre, double yaw_rad, double above_m);
+
 // The green sphere an object is lifted into, 0.3 m above the table at (x, y); seen, not felt.
 sim::ObjectSpec success_zone(const sim::World& world, const Eigen::Vector3d& xy, double radius);
 // grasp_and_lift by 15 cm, then into the scene's "success_zone".

@@ -96,14 +96,9 @@ class SetupCheckers : public Task {
     // From the top of the stack down.
     for (auto i = off_board_.rbegin(); i != off_board_.rend(); ++i) {
       auto pick = grasp_and_lift(world, world.object_id(homes_[*i].first), kAbove);
-      Waypoint over, place, retreat;
-      over.tcp_pose.linear() = place.tcp_pose.linear() = retreat.tcp_pose.linear() = top_down(yaw);
-      place.tcp_pose.translation() = board * homes_[*i].second + Eigen::Vector3d(0, 0, 0.005);
-      over.tcp_pose.translation() = retreat.tcp_pose.translation() = place.tcp_pose.translation() + Eigen::Vector3d(0, 0, kAbove);
-      over.gripper_open = false;
-      place.ignore_collisions = retreat.ignore_collisions = true;  // the checker meets the board
+      const auto place = place_at(board * homes_[*i].second, yaw, kAbove);
       waypoints.insert(waypoints.end(), pick.begin(), pick.end());
-      waypoints.insert(waypoints.end(), {over, place, retreat});
+      waypoints.insert(waypoints.end(), place.begin(), place.end());
     }
     waypoints.pop_back();  // the last release completes the task: the episode ends there
     return waypoints;

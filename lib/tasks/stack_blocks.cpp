@@ -77,15 +77,8 @@ class StackBlocks : public Task {
       pick.back().tcp_pose.translation().z() = table + (stack_ + 1.5) * kBlockSize + 0.05;
       waypoints.insert(waypoints.end(), pick.begin(), pick.end());
       // Above the stack, square to the plane; down to 5 mm above its top; open; back up.
-      Waypoint over, place, retreat;
-      over.tcp_pose.linear() = place.tcp_pose.linear() = retreat.tcp_pose.linear() = top_down(0);
-      place.tcp_pose.translation() = Eigen::Vector3d(plane.x(), plane.y(), table + kBlockSize / 2 + level * kBlockSize + 0.005);
-      over.tcp_pose.translation() = place.tcp_pose.translation() + Eigen::Vector3d(0, 0, 0.1);
-      retreat.tcp_pose.translation() = over.tcp_pose.translation();
-      over.gripper_open = place.gripper_open = false;
-      place.ignore_collisions = retreat.ignore_collisions = true;  // the held block meets the stack
-      place.gripper_open = true;  // opened on arrival: released
-      waypoints.insert(waypoints.end(), {over, place, retreat});
+      const auto place = place_at(Eigen::Vector3d(plane.x(), plane.y(), table + kBlockSize / 2 + level * kBlockSize), 0, 0.1);
+      waypoints.insert(waypoints.end(), place.begin(), place.end());
     }
     waypoints.pop_back();  // the last release completes the task: the episode ends there
     return waypoints;
