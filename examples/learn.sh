@@ -33,8 +33,14 @@ task=$1 run=$2
 : "${ENV_STEPS:=2000}" "${CHUNK_EPISODES:=10}" "${EVAL_EVERY:=250}" "${EVAL_EPISODES:=50}" "${EVAL_SEED:=1000000}"
 : "${ARCH:=light}" "${BATCH:=32}" "${RATIO:=0.5}" "${PRETRAIN:=200}" "${START_AFTER:=0}"
 : "${LEARNER_THREADS:=1}" "${EPSILON:=0.1}" "${ROTATION_NOISE:=1}" "${CHECKPOINT_EVERY:=25}" "${LABEL:=k$ACT_K-$TARGET_K}"
-: "${N_STEP:=1}" "${ACTORS:=1}" "${CPU_BUDGET:=0}"
+: "${N_STEP:=1}" "${ACTORS:=1}" "${CPU_BUDGET:=0}" "${K_MARGIN:=0.02}" "${K_MAX:=10}"
 mkdir -p "$run/chunks" "$run/eval"
+# Adaptive K (ACT_K or TARGET_K 'auto'): each node expands the voxels within K_MARGIN of its
+# best Q, at most K_MAX; the options go only to the programs whose K is 'auto'.
+branching() {  # K -> the options that go with it
+  if [ "$1" = auto ]; then echo "--k-margin $K_MARGIN --k-max $K_MAX"; fi
+}
+act_branching=$(branching "$ACT_K") target_branching=$(branching "$TARGET_K")
 log() { printf '%s %s\n' "$(date +%H:%M:%S)" "$*" >&2; }
 # The time a run spends training, up to each evaluation and summed over resumptions
 # (evaluations excluded; an interrupted chunk's time is not counted: the chunk is run again):
@@ -80,7 +86,7 @@ fi
 rm -f "$run/actor.done"
 qattn-train --follow --resume --stop-file "$run/actor.done" --replay-ratio "$RATIO" --pretrain "$PRETRAIN" \
   --start-after "$START_AFTER" --steps 1000000 --checkpoint-every "$CHECKPOINT_EVERY" --keep 4 \
-  --architecture "$ARCH" --batch "$BATCH" --tree-target "$TARGET_K" --n-step "$N_STEP" --seed "$SEED" --threads "$LEARNER_THREADS" \
+  --architecture "$ARCH" --batch "$BATCH" --tree-target "$TARGET_K" $target_branching --n-step "$N_STEP" --seed "$SEED" --threads "$LEARNER_THREADS" \
   --checkpoint-dir "$run/ckpt" --metrics "$run/train.csv" "$run/replay.rec" 2>> "$run/train.log" &
 learner=$!
 trap 'kill $(jobs -p) 2>/dev/null || true' EXIT  # the learner and any actor still running
@@ -101,7 +107,7 @@ evaluate() {  # CHECKPOINT ENV_STEPS OUT.csv LEARNER_STEP EVAL_POINT
   local fifo; fifo=$(mktemp -u); mkfifo "$fifo"
   sim-step --task "$task" --variation "$VARIATION" --episodes "$EVAL_EPISODES" --seed "$EVAL_SEED" --scenes eval \
     --image-size "$IMAGE" < "$fifo" \
-    | qte-select --checkpoint "$1" --k "$ACT_K" --threads 1 \
+    | qte-select --checkpoint "$1" --k "$ACT_K" $act_branching --threads 1 \
     | plan-path | tee "$fifo" \
     | episode-stats --label "$LABEL" --column seed="$SEED" --column env_steps="$2" --column train_step="$4" \
         --column eval_point="$5" --column train_s="$(cat "$run/train_seconds")" --column cpu_s="$(cat "$run/cpu_seconds")" \
@@ -117,7 +123,7 @@ run_chunk() {  # CHUNK
   fifo=$(mktemp -u); mkfifo "$fifo"
   if ! sim-step --task "$task" --variation "$VARIATION" --episodes "$CHUNK_EPISODES" --seed "$seed" \
       --scenes explore --image-size "$IMAGE" --compress < "$fifo" \
-    | qte-select --checkpoint "$run/ckpt/latest.rec" --reload --k "$ACT_K" --epsilon "$EPSILON" \
+    | qte-select --checkpoint "$run/ckpt/latest.rec" --reload --k "$ACT_K" $act_branching --epsilon "$EPSILON" \
         --rotation-noise "$ROTATION_NOISE" --seed "$seed" --threads 1 2>> "$run/actor.log" \
     | plan-path | tee "$fifo" "$name.partial" \
     | keyframe --agent --seed "$SEED" --append --output "$run/replay.rec" 2>> "$run/actor.log"; then

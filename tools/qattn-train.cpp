@@ -171,8 +171,8 @@ static void run(const cli::Arguments& args) {
   nets::seed_torch(loop.seed);
   learner::QLearner learner(config);
   replay::ReplayBuffer replay(replay_options);
+  learner::InputFollower inputs(args.positional(), loop.follow);  // a missing input fails before any directory is made
   learner::CheckpointDirectory checkpoints(args.text("checkpoint-dir"), static_cast<int>(args.integer("keep", 1, 100000)));
-  learner::InputFollower inputs(args.positional(), loop.follow);
   learner::TrainingLoop training(learner, replay, inputs, checkpoints, loop, std::cerr);
   training.start(args.flag("resume"));
   training.run();

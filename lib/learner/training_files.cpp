@@ -94,7 +94,7 @@ bool InputFollower::finished() const {
 
 CheckpointDirectory::CheckpointDirectory(std::string dir, int keep) : dir_(std::move(dir)), keep_(std::max(1, keep)) {
   std::error_code error;
-  std::filesystem::create_directories(dir_, error);
+  created_ = std::filesystem::create_directories(dir_, error);
   if (error) throw Error("cannot create checkpoint directory " + dir_ + ": " + error.message());
   remove_stale_temporaries(dir_);  // step-N.rec.tmp.PID of a run killed while it wrote
 }
@@ -103,6 +103,13 @@ std::string CheckpointDirectory::path_for(int64_t step) const {
   char name[40];
   std::snprintf(name, sizeof name, "/step-%08lld.rec", static_cast<long long>(step));
   return dir_ + name;
+}
+
+void CheckpointDirectory::discard(int64_t step) {
+  std::error_code ignored;  // best effort: the run is failing already
+  std::filesystem::remove(latest(), ignored);
+  std::filesystem::remove(path_for(step), ignored);
+  if (created_ && std::filesystem::is_empty(dir_, ignored)) std::filesystem::remove(dir_, ignored);
 }
 
 void CheckpointDirectory::publish(int64_t step) {

@@ -41,10 +41,15 @@ class CheckpointDirectory {
   std::string path_for(int64_t step) const;
   // Call after path_for(step) was written completely.
   void publish(int64_t step);
+  // Removes the checkpoint of `step` and latest.rec (published as it), and the directory when
+  // this object created it and it is now empty: a run that failed before it saved anything of
+  // value leaves nothing behind.
+  void discard(int64_t step);
 
  private:
   std::string dir_;
   int keep_;
+  bool created_ = false;  // the directory did not exist before
 };
 
 }  // namespace qte::learner

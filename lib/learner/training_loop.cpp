@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 
 #include <cmath>
+#include <filesystem>
 #include <iomanip>
 #include <ostream>
 #include <random>
@@ -141,6 +142,7 @@ bool TrainingLoop::start(bool resume) {
     resumed = true;
   } else {
     save();
+    fresh_ = true;
   }
   if (!options_.metrics_path.empty()) {
     trim_metrics(options_.metrics_path, resumed ? learner_.step() : -1, header);
@@ -150,6 +152,19 @@ bool TrainingLoop::start(bool resume) {
 }
 
 void TrainingLoop::run() {
+  try {
+    train();
+  } catch (...) {
+    if (fresh_ && last_saved_ == 0) {  // only the initial weights were saved: not worth keeping
+      checkpoints_.discard(0);
+      metrics_.close();
+      if (!options_.metrics_path.empty()) std::filesystem::remove(options_.metrics_path);
+    }
+    throw;
+  }
+}
+
+void TrainingLoop::train() {
   started_ = window_start_ = std::chrono::steady_clock::now();
   bool stopping = false;
   while (learner_.step() < options_.steps) {
@@ -183,8 +198,9 @@ void TrainingLoop::run() {
       for (std::size_t i = 0; i < sample.indices.size() && i < 8; ++i)
         records += (i ? "; " : "") + replay_.transition(sample.indices[i]).position.describe();
       throw Error("step " + std::to_string(step) + ": " + e.what() + " in the batch of " + records +
-                  (sample.indices.size() > 8 ? "; ..." : "") + " (the last good checkpoint is " +
-                  checkpoints_.path_for(last_saved_) + ")");
+                  (sample.indices.size() > 8 ? "; ..." : "") +
+                  (fresh_ && last_saved_ == 0 ? " (no trained checkpoint was saved: none is kept)"
+                                              : " (the last good checkpoint is " + checkpoints_.path_for(last_saved_) + ")"));
     }
     for (std::size_t index : sample.indices) priority_sum_ += replay_.priority(index);
     replay_.update_priorities(sample.indices, stats.td_errors);

@@ -54,7 +54,9 @@ class TrainingLoop {
   // actor can start at once). Returns whether it resumed.
   bool start(bool resume);
   // Trains until options.steps, or with follow until the stop file exists (or every input is
-  // closed) and no more steps are allowed. Ends with a checkpoint of the last step.
+  // closed) and no more steps are allowed. Ends with a checkpoint of the last step. A fresh run
+  // that fails (bad input, a non-finite loss) before it saved a trained checkpoint removes what
+  // it wrote (the initial checkpoint, an empty metrics file) and rethrows: nothing is left behind.
   void run();
 
   int64_t transitions_read() const { return transitions_read_; }
@@ -65,6 +67,7 @@ class TrainingLoop {
   // would exceed `agent_limit` (unless the replay is below --start-after and may fill up to
   // it), or before transition `total_limit`.
   void ingest(int64_t agent_limit, bool fill_to_start_after, int64_t total_limit = INT64_MAX);
+  void train();
   void save();
   void log_row(const StepStats& stats);
 
@@ -76,6 +79,7 @@ class TrainingLoop {
   std::ostream& progress_;
   std::deque<stream::Record> pending_;
   int64_t transitions_read_ = 0, agent_transitions_ = 0, last_saved_ = -1;
+  bool fresh_ = false;  // started without a checkpoint to resume
   std::ofstream metrics_;
   std::chrono::steady_clock::time_point started_, window_start_;
   int64_t window_steps_ = 0, td_count_ = 0;

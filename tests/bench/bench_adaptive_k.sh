@@ -2,7 +2,9 @@
 # Prints what adaptive K costs and expands when acting, against fixed K: qte-select over the
 # observations of 5 recorded expert demonstrations (held-out scenes), one thread, with a trained
 # checkpoint — per setting the seconds per observation, the mean grids expanded at depth 1,
-# and how often the chosen voxel differs from K = 10's.
+# and how often the chosen voxel differs from K = 10's. Then the same for the bootstrap target
+# (tree_target_timing): the checkpoint's online and target networks on minibatches of those
+# demonstrations' transitions, 2 threads.
 # Usage: bench_adaptive_k [CHECKPOINT] [TASK] [IMAGE] [TOOLS_DIR]
 #        (a checkpoint of TASK, e.g. a learn.sh run's ckpt/latest.rec; without one (or with
 #        '-'), networks trained for 150 steps on 3 demonstrations, whose Q volumes say little;
@@ -52,3 +54,8 @@ run k10 --k 10
 run k1 --k 1
 for m in 0.005 0.01 0.02 0.05; do run "margin$m" --k auto --k-margin "$m" --k-max 10; done
 for p in 0.5 0.9; do run "mass$p" --k auto --k-mass "$p" --k-max 10; done
+
+echo
+echo "bootstrap targets (qattn-train --tree-target), learner checkpoint $checkpoint:"
+keyframe --output "$tmp/transitions.rec" "$tmp/demo.rec" 2>/dev/null
+"$here/tree_target_timing" "$checkpoint" "$tmp/transitions.rec" 10 2

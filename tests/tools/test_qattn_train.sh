@@ -106,12 +106,22 @@ grep -q "trained with other settings.*\"architecture\": \"light\"" <<<"$err" || 
 keyframe --voxels 8 --seed 1 "$tmp/demos.rec" > "$tmp/tr8.rec" 2>/dev/null
 err=$(train --steps 2 --checkpoint-dir "$tmp/v" "$tmp/tr8.rec" 2>&1) && fail "8-voxel transitions accepted"
 grep -q "tr8.rec: record [0-9]* at byte [0-9]*: 'transition' record, field 'voxels': expected 16 voxels" <<<"$err" || fail "$err"
-err=$(train --steps 40 --lr 1e30 --grad-clip-value 0 --checkpoint-every 1000 --checkpoint-dir "$tmp/n" "$tmp/tr.rec" 2>&1) \
-  && fail "a diverging run did not stop"
-grep -Eq "step [0-9]*: (non-finite loss|the depth-[0-9] network gave a non-finite Q value).*tr.rec: record [0-9]* at byte.*last good checkpoint is .*step-00000000.rec" \
+# A fresh run that stops before it saved a trained checkpoint leaves nothing behind (its
+# initial checkpoint and metrics file are removed); one that saved trained checkpoints keeps them.
+[ ! -e "$tmp/v" ] || fail "a run refused on bad input left $(ls -A "$tmp/v") behind"
+err=$(train --steps 40 --lr 1e30 --grad-clip-value 0 --checkpoint-every 1000 --metrics "$tmp/n.csv" \
+  --checkpoint-dir "$tmp/n" "$tmp/tr.rec" 2>&1) && fail "a diverging run did not stop"
+grep -Eq "step [0-9]*: (non-finite loss|the depth-[0-9] network gave a non-finite Q value).*tr.rec: record [0-9]* at byte.*no trained checkpoint was saved" \
   <<<"$(tail -1 <<<"$err")" || fail "$err"
+[ ! -e "$tmp/n" ] && [ ! -e "$tmp/n.csv" ] || fail "a diverged run without a trained checkpoint left files behind"
+err=$(train --steps 40 --lr 1e30 --grad-clip-value 0 --checkpoint-every 1 --checkpoint-dir "$tmp/n1" "$tmp/tr.rec" 2>&1) \
+  && fail "a diverging run did not stop"
+good=$(grep -o "last good checkpoint is [^ )]*" <<<"$err" | sed 's/.* is //')
+[ -n "$good" ] && [ -f "$good" ] && [ -f "$tmp/n1/latest.rec" ] || fail "the last good checkpoint was not kept: $err"
 err=$(train --steps 2 --checkpoint-dir "$tmp/m" "$tmp/missing.rec" 2>&1) && fail "missing file accepted"
 grep -q "missing.rec" <<<"$err" || fail "$err"
+[ ! -e "$tmp/m" ] || fail "a missing input left a checkpoint directory"
 err=$(qattn-train --steps 2 --start-after 1000 --checkpoint-dir "$tmp/s" "$tmp/tr.rec" 2>&1) && fail "too few transitions"
 grep -q "fewer than --start-after 1000" <<<"$err" || fail "$err"
+[ ! -e "$tmp/s" ] || fail "too few transitions left a checkpoint directory"
 echo "qattn-train ok"
