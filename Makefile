@@ -50,15 +50,20 @@ sanitize: deps
 	ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ctest --test-dir $(BUILD)-asan --output-on-failure -j $(JOBS) -LE slow
 
-# libFuzzer on the stream reader for FUZZ_SECONDS (clang from debian-packages.txt).
+# libFuzzer for FUZZ_SECONDS per target (clang from debian-packages.txt): the stream decoder,
+# then each record type's readers (tests/fuzz/fuzz_<target>.cpp, seeds in tests/fuzz/corpus/<target>/).
+FUZZ_TARGETS ?= stream_reader obs action trajectory transition checkpoint
 fuzz: deps
 	cmake -S . -B $(BUILD)-fuzz -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
 	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DQTE_FUZZ=ON -DQTE_TESTS=ON $(CMAKE_FLAGS)
-	cmake --build $(BUILD)-fuzz -j $(JOBS) --target fuzz_stream_reader
-	mkdir -p tests/fuzz/findings $(BUILD)-fuzz/corpus
-	$(BUILD)-fuzz/tests/fuzz/fuzz_stream_reader -max_total_time=$(FUZZ_SECONDS) \
-	  -artifact_prefix=tests/fuzz/findings/ -print_final_stats=1 \
-	  $(BUILD)-fuzz/corpus tests/fuzz/corpus
+	cmake --build $(BUILD)-fuzz -j $(JOBS) --target $(addprefix fuzz_,$(FUZZ_TARGETS))
+	mkdir -p tests/fuzz/findings
+	for t in $(FUZZ_TARGETS); do \
+	  mkdir -p $(BUILD)-fuzz/corpus/$$t; \
+	  $(BUILD)-fuzz/tests/fuzz/fuzz_$$t -max_total_time=$(FUZZ_SECONDS) -rss_limit_mb=4096 \
+	    -artifact_prefix=tests/fuzz/findings/$$t- -print_final_stats=1 \
+	    $(BUILD)-fuzz/corpus/$$t tests/fuzz/corpus/$$t || exit 1; \
+	done
 
 # Regenerates man/*.1 from the programs' own --help-man (a test checks they agree).
 man: build

@@ -4,7 +4,7 @@
 // go through every setting, interleaved batch by batch so that a noisy machine slows all of
 // them alike. Per setting: the median seconds of one target computation (the next states'
 // voxelization included), the mean grids expanded per node at depth 1, and the mean absolute
-// difference of the depth-0 target from K = 10's. bench_adaptive_k runs it after the acting
+// difference of the depth-0 target from K = 10's (every sample bootstrapping, terminal or not). bench_adaptive_k runs it after the acting
 // figures, on the same checkpoint.
 //
 // Usage: tree_target_timing CHECKPOINT REPLAY [BATCHES [THREADS]]   (defaults 10 batches of 32, 2 threads)
@@ -95,7 +95,10 @@ int main(int argc, char** argv) try {
 
   for (int b = 0; b <= batches; ++b) {  // batch 0 warms up
     std::mt19937_64 rng(b);
-    const learner::Minibatch batch = learner::assemble_minibatch(replay, replay.sample(config.batch, 0.0, rng), config);
+    learner::Minibatch batch = learner::assemble_minibatch(replay, replay.sample(config.batch, 0.0, rng), config);
+    // Every sample bootstraps (a demonstration's last transition would not: its target is the
+    // reward alone), so that the targets compared below are the trees' values.
+    batch.discount.assign(batch.discount.size(), static_cast<float>(config.gamma));
     std::vector<float> reference;
     for (Setting& s : settings) {
       config.tree_target_k = s.tree_target_k;

@@ -6,7 +6,7 @@ file left behind.
 
 The inputs are made here by the programs themselves (a 32x32 reach_target demonstration, its
 transitions, a learner checkpoint, the agent's actions, the planner's trajectory). Per program
-a seeded sample of MUTATIONS (default 24) of its cases runs; QTE_MUTATIONS=all runs every case
+a seeded sample of QTE_MUTATIONS (default 12) of its cases runs; QTE_MUTATIONS=all runs every case
 (a few thousand runs, about half an hour on 2 cores)."""
 import os, random, re, struct, subprocess, sys, tempfile, time, zlib
 
@@ -17,7 +17,7 @@ sys.path.insert(0, os.path.join(SOURCE, "examples"))
 import read_stream  # noqa: E402
 
 TOOLS = os.environ.get("QTE_TOOLS", "build/tools")
-LIMIT = os.environ.get("QTE_MUTATIONS", "24")
+LIMIT = os.environ.get("QTE_MUTATIONS", "12")
 TIMEOUT_S = 120
 tmp = tempfile.mkdtemp(prefix="qte_mutations_")
 failures = []
@@ -208,8 +208,13 @@ def check(program, description, argv, data, output=None, stdout_stream=True, wor
         subprocess.run(["rm", "-rf", made_here])
 
 
+total = 0  # cases there are, sampled or not
+
+
 def sample(all_cases, salt):
+    global total
     all_cases = list(all_cases)
+    total += len(all_cases)
     if LIMIT == "all" or len(all_cases) <= int(LIMIT):
         return all_cases
     return random.Random(salt).sample(all_cases, int(LIMIT))
@@ -270,5 +275,5 @@ for description, data in sample(cases(ckpt_recs, [0]), "checkpoint"):
     ran += 1
 
 print("\n".join(failures[:60]))
-print(f"{ran} mutated inputs, {len(failures)} failures")
+print(f"{ran} mutated inputs of {total} cases (QTE_MUTATIONS={LIMIT} per program), {len(failures)} failures")
 sys.exit(1 if failures else 0)
