@@ -307,9 +307,17 @@ cv::Mat draw(const std::vector<Curve>& curves, Axis x_axis, Axis y_axis, const L
     draw_text_upwards(image, labels.y, {gap + label_height / 2, plot.area.y + plot.area.height / 2},
                       style.label_scale, style.thickness, kInk);
   if (!labels.title.empty()) {
-    const cv::Size s = text_size(labels.title, style.title_scale, style.thickness);
-    draw_text(image, labels.title, {plot.area.x + plot.area.width / 2 - s.width / 2, gap * 2}, style.title_scale,
-              style.thickness, kInk);
+    // A title wider than the picture is drawn smaller, never cut off; it is centred on the
+    // data area as far as the picture's edges allow.
+    const int room = size.width - 2 * gap;
+    double title_scale = style.title_scale;
+    cv::Size s = text_size(labels.title, title_scale, style.thickness);
+    if (s.width > room) {
+      title_scale *= 0.98 * room / s.width;
+      s = text_size(labels.title, title_scale, style.thickness);
+    }
+    const int centre = std::max(gap + s.width / 2, std::min(plot.area.x + plot.area.width / 2, size.width - gap - s.width / 2));
+    draw_text(image, labels.title, {centre - s.width / 2, gap * 2}, title_scale, style.thickness, kInk);
   }
   if (labels.legend) draw_legend(image, plot, curves, style);
   return image;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <opencv2/imgcodecs.hpp>
 
 #include "common/error.hpp"
 #include "report/curve_plot.hpp"
@@ -141,4 +142,25 @@ TEST(CurvePlot, ARangeBeyondWhatADoubleHoldsIsAnError) {
       EXPECT_NE(std::string(e.what()).find("more than a plot can draw"), std::string::npos) << e.what();
     }
   }
+}
+
+// A title wider than the picture is drawn smaller: its ink stays inside the picture's margins.
+TEST(CurvePlot, ALongTitleIsShrunkNotCutOff) {
+  CurveBuilder builder({"step", "success_rate", "label"}, Band::ci);
+  builder.add(parse_csv("runs.csv", kRuns));
+  CurvePlotOptions options;
+  options.width_px = 400;
+  options.height_px = 300;
+  options.title = "lift_numbered_block: qte-k10-t10 against c2farm-k1-t0, mean and std over seeds 0, 1 and 2";
+  const std::vector<uint8_t> png = curve_plot_png(builder.curves(), options);
+  const cv::Mat image = cv::imdecode(png, cv::IMREAD_GRAYSCALE);
+  ASSERT_EQ(image.cols, 400);
+  int left = image.cols, right = -1;
+  for (int y = 0; y < 30; ++y)  // the title's band, above the data area
+    for (int x = 0; x < image.cols; ++x)
+      if (image.at<uint8_t>(y, x) < 128) left = std::min(left, x), right = std::max(right, x);
+  ASSERT_GE(right, 0) << "no title drawn";
+  EXPECT_GE(left, 3);
+  EXPECT_LE(right, image.cols - 4);
+  EXPECT_GT(right - left, image.cols / 2);  // shrunk to fit, not to nothing
 }
