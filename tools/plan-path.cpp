@@ -1,7 +1,7 @@
 // plan-path: next-best poses to collision-free joint trajectories on the sensed scene.
 #include "cli/command.hpp"
 #include "planning/motion_planner.hpp"
-#include "sim/world.hpp"
+#include "sim/scene_layout.hpp"
 #include "stream/reader.hpp"
 #include "stream/writer.hpp"
 

@@ -55,7 +55,7 @@ Minibatch assemble_minibatch(const replay::ReplayBuffer& replay, const replay::S
     for (int d = 0; d < depths; ++d) {
       const voxels::GridBounds g = voxels::bounds_field(t, depth_field(d, "bounds"), v);
       const auto index3 = t.array<int32_t>(depth_field(d, "index"));
-      b.voxel[d][i] = (static_cast<int64_t>(index3[0]) * v + index3[1]) * v + index3[2];
+      b.voxel[d][i] = voxels::flat_index(Eigen::Vector3i(index3[0], index3[1], index3[2]), v);
       voxels::voxelize(cloud.view(), g, b.grids[d].data() + i * grid_floats);
     }
     const std::vector<float> p = qattention::proprio_of(frame, t.scalar<int32_t>("step"));

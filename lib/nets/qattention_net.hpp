@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "keyframes/keyframes.hpp"
+
 namespace qte::nets {
 
 enum class Architecture {
@@ -24,7 +26,7 @@ int default_base_channels(Architecture architecture);          // arm 64, light 
 
 // Rotation Q values: 3 Euler axes x 72 bins of 5 degrees; gripper: open / close.
 constexpr int kRotationAxes = 3;
-constexpr int kRotationBins = 72;
+using keyframes::kRotationBins;  // the action encoding's bins (keyframes/keyframes.hpp)
 constexpr int kGripperActions = 2;
 
 struct NetConfig {

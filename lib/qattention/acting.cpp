@@ -23,8 +23,6 @@ stream::Record checkpoint_record(const std::string& path) {
   return std::move(*record);
 }
 
-int flat_index(const Eigen::Vector3i& i, int v) { return (i.x() * v + i.y()) * v + i.z(); }
-
 constexpr int kOccupancyChannel = voxels::kChannels - 1;  // 1 when the voxel holds a point
 
 // The value of a path as the tree values its best path: from the last depth up, each depth
@@ -106,7 +104,7 @@ Action act(const DepthEvaluator& evaluate, const voxels::CoarseToFine& hierarchy
   if (changed) {
     Choice& c = action.choice;
     for (int d = 0; d < hierarchy.depths; ++d)
-      if (explored.replaced[d]) c.q_values[d] = action.grids.at(d).q[flat_index(c.indices[d], hierarchy.voxels())];
+      if (explored.replaced[d]) c.q_values[d] = action.grids.at(d).q[voxels::flat_index(c.indices[d], hierarchy.voxels())];
     c.value = path_value(c.q_values);
   }
   return action;
@@ -118,7 +116,7 @@ void save_q_pictures(const std::string& dir, uint64_t index, Action& action) {
   for (int d = 0; d < static_cast<int>(c.indices.size()); ++d) {
     const GridQ& g = action.grids.at(d);
     const int v = c.bounds[d].voxels;
-    const int chosen_voxel = flat_index(c.indices[d], v);
+    const int chosen_voxel = voxels::flat_index(c.indices[d], v);
     voxels::VoxelImageOptions picture;
     picture.min_value = std::numeric_limits<float>::lowest();
     picture.values.assign(g.q.size(), picture.min_value);  // empty voxels are not drawn

@@ -7,11 +7,11 @@
 #include <vector>
 
 #include "stream/record.hpp"
+#include "tasks/episode.hpp"
 
 namespace qte::qattention {
 
 constexpr int kProprio = 4;
-constexpr int kEpisodeLength = 10;  // when a record has no episode_length (tasks::Task::kEpisodeLength)
 
 // From an 'obs' or 'frame' record (gripper_open, gripper_opening_m) and the number of
 // next-best poses taken before it. Throws StreamError naming a missing field.

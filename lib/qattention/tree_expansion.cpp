@@ -54,7 +54,6 @@ std::vector<int> branches(const float* q, int count, const Branching& branching)
 
 namespace {
 
-Eigen::Vector3i unflatten(int flat, int v) { return Eigen::Vector3i(flat / (v * v), (flat / v) % v, flat % v); }
 
 int argmax(const float* q, int count) { return top_k(q, count, 1)[0]; }
 
@@ -129,7 +128,7 @@ std::vector<Choice> expand_batch(const DepthEvaluator& rank, const DepthEvaluato
     if (d + 1 == depths) break;
     for (int i = 0; i < n; ++i)
       for (int flat : branches(ranked[d].translation.data() + static_cast<std::size_t>(i) * cells, cells, branching))
-        levels[d + 1].push_back({hierarchy.bounds_at(d + 1, level[i].bounds.centre_of(unflatten(flat, v))),
+        levels[d + 1].push_back({hierarchy.bounds_at(d + 1, level[i].bounds.centre_of(voxels::index_from_flat(flat, v))),
                                  level[i].observation, i, flat});
   }
 
@@ -172,7 +171,7 @@ std::vector<Choice> expand_batch(const DepthEvaluator& rank, const DepthEvaluato
       const std::size_t at = static_cast<std::size_t>(node) * cells;
       const int voxel = d + 1 < depths ? levels[d + 1][best_child[d][node]].parent_voxel
                                        : argmax(ranked[d].translation.data() + at, cells);
-      choice.indices.push_back(unflatten(voxel, v));
+      choice.indices.push_back(voxels::index_from_flat(voxel, v));
       choice.bounds.push_back(levels[d][node].bounds);
       choice.q_values.push_back(outputs[d].translation[at + voxel]);
       if (d + 1 < depths) node = best_child[d][node];

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "render/camera.hpp"
+#include "sim/scene_layout.hpp"
 #include "robot/robot_model.hpp"
 
 class btCollisionWorld;
@@ -37,20 +38,6 @@ struct ObjectSpec {
   bool collides = true;     // false: seen by cameras only (e.g. a success zone)
   bool graspable = true;
   render::Appearance appearance;
-};
-
-// What the table and the robot base look like; tasks share one layout (DESIGN §4-§5).
-struct SceneLayout {
-  double table_height_m = 0.752;
-  Eigen::Vector3d table_centre{0.2, 0.0, 0.752};  // top surface centre
-  Eigen::Vector2d table_extent_m{1.2, 1.4};
-  Eigen::Vector3d robot_base{-0.3, 0.0, 0.752};
-
-  Eigen::Isometry3d robot_base_pose() const {  // facing +x, on the table
-    Eigen::Isometry3d base = Eigen::Isometry3d::Identity();
-    base.translation() = robot_base;
-    return base;
-  }
 };
 
 class World {

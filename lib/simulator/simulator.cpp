@@ -100,7 +100,7 @@ stream::Record Simulator::observe(const std::string& failure) {
   obs.set_scalar<int32_t>("episode_length", task_->episode_length());
   obs.set_scalar<int32_t>("frame", frame_++);
   obs.set_scalar<double>("time_s", time_s_);
-  obs.set_scalar<float>("reward", success_ ? tasks::Task::kSuccessReward : 0.0f);
+  obs.set_scalar<float>("reward", success_ ? tasks::kSuccessReward : 0.0f);
   obs.set_scalar<uint8_t>("terminal", terminal_);
   obs.set_scalar<uint8_t>("success", success_);
   obs.set_string("task", task_name_);

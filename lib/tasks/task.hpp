@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sim/world.hpp"
+#include "tasks/episode.hpp"
 
 namespace qte::tasks {
 
@@ -34,9 +35,7 @@ class Task {
 
   // Next-best poses per episode: the published 10, more where the expert needs more
   // (its keyframes plus slack). The 'obs' records carry it as episode_length.
-  virtual int episode_length() const { return kEpisodeLength; }
-  static constexpr int kEpisodeLength = 10;
-  static constexpr float kSuccessReward = 100.0f;
+  virtual int episode_length() const { return kPublishedEpisodeLength; }
 };
 
 // The tasks by name; an unknown name is an Error listing the known ones.

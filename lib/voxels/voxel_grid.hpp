@@ -30,6 +30,14 @@ struct GridBounds {
   static GridBounds parse(const std::string& text, int voxels);
 };
 
+// A voxel's place in a grid's flat array (index order x, y, z: z varies fastest), and back.
+inline int flat_index(const Eigen::Vector3i& index, int voxels) {
+  return (index.x() * voxels + index.y()) * voxels + index.z();
+}
+inline Eigen::Vector3i index_from_flat(int flat, int voxels) {
+  return Eigen::Vector3i(flat / (voxels * voxels), (flat / voxels) % voxels, flat % voxels);
+}
+
 // The hierarchy: scene bounds at depth 0, `depths` levels of `voxels`^3, and one offset (half
 // edge) per depth below 0: published 0.15 m for the 2-depth C2F-ARM.
 struct CoarseToFine {

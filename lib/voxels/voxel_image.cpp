@@ -48,12 +48,13 @@ void save_voxel_png(const std::string& path, const float* grid, int voxels, cons
     if (drawn) order.push_back(i);
   }
   auto depth = [&](int i) {
-    const int x = i / (voxels * voxels), y = (i / voxels) % voxels, z = i % voxels;
-    return z - (x + y);
+    const Eigen::Vector3i at = index_from_flat(i, voxels);
+    return at.z() - (at.x() + at.y());
   };
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return depth(a) < depth(b); });
   for (int i : order) {
-    const int x = i / (voxels * voxels), y = (i / voxels) % voxels, z = i % voxels;
+    const Eigen::Vector3i at = index_from_flat(i, voxels);
+    const int x = at.x(), y = at.y(), z = at.z();
     cv::Vec3d bgr;
     if (options.values.empty()) {
       const float* c = grid + i * kChannels;
