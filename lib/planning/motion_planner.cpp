@@ -29,6 +29,26 @@ class SeededSampler : public ob::RealVectorStateSampler {
   }
 };
 
+// Straight TCP lines take a step at least every this much rotation (their translation step
+// is the straight_step_m option): small enough that IK follows one solution branch.
+constexpr double kStraightStep_rad = 0.05;
+// An IK solution more than this away from the previous step's, in any joint, has jumped to
+// another branch: the TCP would not move in a straight line there.
+constexpr double kBranchJump_rad = 0.3;
+// RRT-Connect's longest edge in joint space (rad, Euclidean over the 7 joints). OMPL's default,
+// 0.2 of the space's extent, is about 3 rad here; shorter edges extend the trees in steps a
+// collision check along the edge rarely rejects. Chosen, not tuned by a measurement here.
+constexpr double kRrtRange_rad = 0.5;
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+PlanResult failed(const std::string& reason, Clock::time_point t0) {
+  PlanResult result;
+  result.failure = reason;
+  result.planning_time_s = seconds_since(t0);
+  return result;
+}
+
 robot::JointVector to_joints(const ob::State* state) {
   const auto* v = state->as<ob::RealVectorStateSpace::StateType>();
   robot::JointVector q;
@@ -67,7 +87,11 @@ Goal goal_from(const stream::Record& action) {
 
 MotionPlanner::MotionPlanner(const robot::RobotModel& robot, const Eigen::Isometry3d& world_from_base,
                              PlannerOptions options)
-    : robot_(robot), world_from_base_(world_from_base), options_(options), spheres_(robot) {
+    : robot_(robot),
+      world_from_base_(world_from_base),
+      options_(options),
+      spheres_(robot),
+      checker_(spheres_, world_from_base, {options.clearance_m, options.check_step_rad, options.table_height_m}) {
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
 }
 
@@ -96,25 +120,6 @@ OccupancyScene MotionPlanner::scene_from(const stream::Record& obs, const StartS
   return scene;
 }
 
-bool MotionPlanner::state_valid(const robot::JointVector& q, double opening_m, const OccupancyScene* scene) const {
-  thread_local std::vector<Sphere> placed;
-  spheres_.place(q, opening_m, world_from_base_, placed);
-  if (spheres_.self_collision(placed, 0.01)) return false;
-  // The camera sees only the table top; below it is solid, not free. The base link (0)
-  // stands on it.
-  for (const Sphere& s : placed)
-    if (s.link != 0 && s.centre.z() - s.radius_m < options_.table_height_m - 0.005) return false;
-  return !scene || !scene->collides(placed, options_.clearance_m);
-}
-
-bool MotionPlanner::motion_valid(const robot::JointVector& a, const robot::JointVector& b, double opening_m,
-                                 const OccupancyScene* scene) const {
-  const int steps = std::max(1, static_cast<int>(std::ceil((b - a).cwiseAbs().maxCoeff() / options_.check_step_rad)));
-  for (int i = 1; i <= steps; ++i)
-    if (!state_valid(a + (b - a) * (static_cast<double>(i) / steps), opening_m, scene)) return false;
-  return true;
-}
-
 std::vector<robot::JointVector> MotionPlanner::shortcut(std::vector<robot::JointVector> path, double opening_m,
                                                         const OccupancyScene* scene) const {
   // Greedy string pulling: from each kept waypoint jump to the farthest one reachable in a
@@ -123,7 +128,7 @@ std::vector<robot::JointVector> MotionPlanner::shortcut(std::vector<robot::Joint
   std::size_t i = 0;
   while (i + 1 < path.size()) {
     std::size_t j = path.size() - 1;
-    while (j > i + 1 && !motion_valid(path[i], path[j], opening_m, scene)) --j;
+    while (j > i + 1 && !checker_.motion_valid(path[i], path[j], opening_m, scene)) --j;
     out.push_back(path[j]);
     i = j;
   }
@@ -135,7 +140,8 @@ bool MotionPlanner::straight_line(const robot::JointVector& start, const Eigen::
   const Eigen::Isometry3d from = robot_.tcp_pose(start);
   const double distance = (goal_in_base.translation() - from.translation()).norm();
   const double angle = Eigen::AngleAxisd(goal_in_base.linear() * from.linear().transpose()).angle();
-  const int steps = std::max(1, static_cast<int>(std::ceil(std::max(distance / options_.straight_step_m, angle / 0.05))));
+  const int steps = std::max(1, static_cast<int>(std::ceil(std::max(distance / options_.straight_step_m,
+                                                                     angle / kStraightStep_rad))));
   const Eigen::Quaterniond q0(from.linear()), q1(goal_in_base.linear());
   path = {start};
   robot::IkOptions ik;
@@ -146,101 +152,117 @@ bool MotionPlanner::straight_line(const robot::JointVector& start, const Eigen::
     pose.translation() = from.translation() + t * (goal_in_base.translation() - from.translation());
     pose.linear() = q0.slerp(t, q1).toRotationMatrix();
     const auto q = robot::solve_ik(robot_, pose, path.back(), ik);
-    if (!q || (*q - path.back()).cwiseAbs().maxCoeff() > 0.3) return false;
-    if (!state_valid(*q, opening_m, nullptr)) return false;
+    if (!q || (*q - path.back()).cwiseAbs().maxCoeff() > kBranchJump_rad) return false;
+    if (!checker_.state_valid(*q, opening_m, nullptr)) return false;
     path.push_back(*q);
   }
   return true;
 }
 
+PlanResult MotionPlanner::finish(std::vector<robot::JointVector> path, const std::string& method,
+                                 Clock::time_point t0) const {
+  const robot::JointVector vmax = robot_.max_velocities() * options_.velocity_scale;
+  const robot::JointVector amax = robot::JointVector::Constant(options_.max_acceleration_rad_s2);
+  TimedPath timed = time_parametrize(path, vmax, amax, options_.sample_period_s);
+  PlanResult result;
+  result.time_s = std::move(timed.time_s);
+  result.joint_positions = std::move(timed.joint_positions);
+  result.method = method;
+  result.planning_time_s = seconds_since(t0);
+  return result;
+}
+
 PlanResult MotionPlanner::plan(const StartState& start, const Goal& goal, const OccupancyScene& scene,
                                uint64_t plan_index) const {
   const auto t0 = Clock::now();
-  PlanResult result;
-  auto finish = [&](std::vector<robot::JointVector> path, const std::string& method) {
-    const robot::JointVector vmax = robot_.max_velocities() * options_.velocity_scale;
-    const robot::JointVector amax = robot::JointVector::Constant(options_.max_acceleration_rad_s2);
-    TimedPath timed = time_parametrize(path, vmax, amax, options_.sample_period_s);
-    result.time_s = std::move(timed.time_s);
-    result.joint_positions = std::move(timed.joint_positions);
-    result.method = method;
-    result.planning_time_s = std::chrono::duration<double>(Clock::now() - t0).count();
-    return result;
-  };
-  auto fail = [&](const std::string& reason) {
-    result.failure = reason;
-    result.planning_time_s = std::chrono::duration<double>(Clock::now() - t0).count();
-    return result;
-  };
-
-  if (!goal.pose_valid) return fail("invalid_pose");
+  if (!goal.pose_valid) return failed("invalid_pose", t0);
   const Eigen::Isometry3d goal_in_base = world_from_base_.inverse() * goal.tcp_pose;
   // Farther than the TCP can ever be from the shoulder (0.93 m): no IK restarts needed.
-  if ((goal_in_base.translation() - Eigen::Vector3d(0, 0, 0.267)).norm() > 0.95) return fail("outside_workspace");
+  if ((goal_in_base.translation() - Eigen::Vector3d(0, 0, 0.267)).norm() > 0.95) return failed("outside_workspace", t0);
 
   robot::IkOptions ik;
   ik.seed = derive_seed(options_.seed, plan_index);
-  const double opening = start.opening_m;
+  if (goal.ignore_collisions) return plan_ignoring_scene(start, goal_in_base, ik, t0);
 
-  if (goal.ignore_collisions) {
-    std::vector<robot::JointVector> path;
-    if (straight_line(start.joints, goal_in_base, opening, path)) return finish(path, "straight_line");
-    const auto q = robot::solve_ik(robot_, goal_in_base, start.joints, ik);
-    if (!q) return fail("ik_failed");
-    if (!motion_valid(start.joints, *q, opening, nullptr)) return fail("no_path");
-    return finish({start.joints, *q}, "direct");
-  }
+  if (!checker_.state_valid(start.joints, start.opening_m, &scene)) return failed("start_in_collision", t0);
+  std::string failure;
+  const auto goal_q = goal_configuration(start, goal_in_base, scene, ik, failure);
+  if (!goal_q) return failed(failure, t0);
+  if (checker_.motion_valid(start.joints, *goal_q, start.opening_m, &scene))
+    return finish({start.joints, *goal_q}, "direct", t0);
+  return rrt_connect(start, *goal_q, scene, plan_index, t0);
+}
 
-  if (!state_valid(start.joints, opening, &scene)) return fail("start_in_collision");
-  // Several IK solutions: the nearest collision-free one is the goal.
-  std::optional<robot::JointVector> goal_q;
+// Grasp approaches and retreats: a straight line of the TCP, else straight in joint space,
+// checked against the robot and the table only.
+PlanResult MotionPlanner::plan_ignoring_scene(const StartState& start, const Eigen::Isometry3d& goal_in_base,
+                                              robot::IkOptions ik, Clock::time_point t0) const {
+  std::vector<robot::JointVector> path;
+  if (straight_line(start.joints, goal_in_base, start.opening_m, path)) return finish(path, "straight_line", t0);
+  const auto q = robot::solve_ik(robot_, goal_in_base, start.joints, ik);
+  if (!q) return failed("ik_failed", t0);
+  if (!checker_.motion_valid(start.joints, *q, start.opening_m, nullptr)) return failed("no_path", t0);
+  return finish({start.joints, *q}, "direct", t0);
+}
+
+// Several IK solutions: the first collision-free one is the goal. `failure` says why there is none.
+std::optional<robot::JointVector> MotionPlanner::goal_configuration(const StartState& start,
+                                                                    const Eigen::Isometry3d& goal_in_base,
+                                                                    const OccupancyScene& scene, robot::IkOptions ik,
+                                                                    std::string& failure) const {
   bool any_solution = false;
-  for (int attempt = 0; attempt < 4 && !goal_q; ++attempt) {
+  for (int attempt = 0; attempt < 4; ++attempt) {
     ik.seed = derive_seed(ik.seed, attempt);
     const auto q = robot::solve_ik(robot_, goal_in_base, start.joints, ik);
     if (!q) break;
     any_solution = true;
-    if (state_valid(*q, opening, &scene)) goal_q = q;
+    if (checker_.state_valid(*q, start.opening_m, &scene)) return q;
   }
-  if (!any_solution) return fail("ik_failed");
-  if (!goal_q) return fail("goal_in_collision");
-  if (motion_valid(start.joints, *goal_q, opening, &scene)) return finish({start.joints, *goal_q}, "direct");
+  failure = any_solution ? "goal_in_collision" : "ik_failed";
+  return std::nullopt;
+}
 
-  // RRT-Connect in joint space. Joints with 720-degree ranges are kept within half a turn
-  // of the start: more is never needed and it keeps collision checks dense.
+// RRT-Connect in joint space. Joints with 720-degree ranges are kept within half a turn of
+// the start: more is never needed and it keeps collision checks dense.
+PlanResult MotionPlanner::rrt_connect(const StartState& start, const robot::JointVector& goal_q,
+                                      const OccupancyScene& scene, uint64_t plan_index, Clock::time_point t0) const {
   auto space = std::make_shared<ob::RealVectorStateSpace>(robot::kArmJoints);
   ob::RealVectorBounds bounds(robot::kArmJoints);
   const robot::JointVector lo = robot_.lower_limits(), hi = robot_.upper_limits();
   for (int k = 0; k < robot::kArmJoints; ++k) {
-    bounds.setLow(k, std::max(lo[k], std::min(start.joints[k], (*goal_q)[k]) - M_PI));
-    bounds.setHigh(k, std::min(hi[k], std::max(start.joints[k], (*goal_q)[k]) + M_PI));
+    bounds.setLow(k, std::max(lo[k], std::min(start.joints[k], goal_q[k]) - M_PI));
+    bounds.setHigh(k, std::min(hi[k], std::max(start.joints[k], goal_q[k]) + M_PI));
   }
   space->setBounds(bounds);
+  // The sampler's own stream, apart from the IK seeds drawn from the same --seed.
   const uint64_t sampler_seed = derive_seed(options_.seed ^ 0x5a5a5a5aull, plan_index);
   space->setStateSamplerAllocator([sampler_seed](const ob::StateSpace* s) {
     return std::make_shared<SeededSampler>(s, sampler_seed);
   });
   og::SimpleSetup setup(space);
-  setup.setStateValidityChecker([&](const ob::State* s) { return state_valid(to_joints(s), opening, &scene); });
+  const double opening = start.opening_m;
+  setup.setStateValidityChecker([&](const ob::State* s) { return checker_.state_valid(to_joints(s), opening, &scene); });
   setup.getSpaceInformation()->setStateValidityCheckingResolution(options_.check_step_rad / space->getMaximumExtent());
   ob::ScopedState<> from(space), to(space);
   for (int k = 0; k < robot::kArmJoints; ++k) {
     from[k] = start.joints[k];
-    to[k] = (*goal_q)[k];
+    to[k] = goal_q[k];
   }
   setup.setStartAndGoalStates(from, to);
   auto planner = std::make_shared<og::RRTConnect>(setup.getSpaceInformation());
-  planner->setRange(0.5);
+  planner->setRange(kRrtRange_rad);
   setup.setPlanner(planner);
   setup.setup();
   const ob::PlannerStatus status = setup.solve(ob::plannerOrTerminationCondition(
       ob::timedPlannerTerminationCondition(options_.time_budget_s),
       ob::exactSolnPlannerTerminationCondition(setup.getProblemDefinition())));
   if (status != ob::PlannerStatus::EXACT_SOLUTION)
-    return fail(status == ob::PlannerStatus::TIMEOUT || status == ob::PlannerStatus::APPROXIMATE_SOLUTION ? "timeout" : "no_path");
+    return failed(status == ob::PlannerStatus::TIMEOUT || status == ob::PlannerStatus::APPROXIMATE_SOLUTION ? "timeout"
+                                                                                                          : "no_path",
+                  t0);
   std::vector<robot::JointVector> path;
   for (const ob::State* s : setup.getSolutionPath().getStates()) path.push_back(to_joints(s));
-  return finish(shortcut(path, opening, &scene), "rrt_connect");
+  return finish(shortcut(path, opening, &scene), "rrt_connect", t0);
 }
 
 stream::Record action_record(const Goal& goal) {

@@ -6,12 +6,14 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <chrono>
 #include <optional>
 #include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "planning/collision_checker.hpp"
 #include "planning/occupancy_scene.hpp"
 #include "planning/robot_spheres.hpp"
 #include "sim/scene_layout.hpp"
@@ -62,6 +64,8 @@ stream::Record action_record(const Goal& goal);  // pose, gripper_open, ignore_c
 
 class MotionPlanner {
  public:
+  using Clock = std::chrono::steady_clock;
+
   MotionPlanner(const robot::RobotModel& robot, const Eigen::Isometry3d& world_from_base,
                 PlannerOptions options = {});
 
@@ -72,12 +76,19 @@ class MotionPlanner {
   PlanResult plan(const StartState& start, const Goal& goal, const OccupancyScene& scene,
                   uint64_t plan_index = 0) const;
 
-  // For tests and benchmarks: self-collision, and the scene when given (null: none).
-  bool state_valid(const robot::JointVector& q, double opening_m, const OccupancyScene* scene) const;
+  const CollisionChecker& collisions() const { return checker_; }
 
  private:
-  bool motion_valid(const robot::JointVector& a, const robot::JointVector& b, double opening_m,
-                    const OccupancyScene* scene) const;
+  // The steps of plan(): a move that ignores the sensed scene; the goal configuration (the
+  // nearest collision-free IK solution); RRT-Connect between start and goal configurations.
+  PlanResult plan_ignoring_scene(const StartState& start, const Eigen::Isometry3d& goal_in_base,
+                                 robot::IkOptions ik, Clock::time_point t0) const;
+  std::optional<robot::JointVector> goal_configuration(const StartState& start, const Eigen::Isometry3d& goal_in_base,
+                                                       const OccupancyScene& scene, robot::IkOptions ik,
+                                                       std::string& failure) const;
+  PlanResult rrt_connect(const StartState& start, const robot::JointVector& goal_q, const OccupancyScene& scene,
+                         uint64_t plan_index, Clock::time_point t0) const;
+  PlanResult finish(std::vector<robot::JointVector> path, const std::string& method, Clock::time_point t0) const;
   std::vector<robot::JointVector> shortcut(std::vector<robot::JointVector> path, double opening_m,
                                            const OccupancyScene* scene) const;
   bool straight_line(const robot::JointVector& start, const Eigen::Isometry3d& goal_in_base,
@@ -87,6 +98,7 @@ class MotionPlanner {
   Eigen::Isometry3d world_from_base_;
   PlannerOptions options_;
   RobotSpheres spheres_;
+  CollisionChecker checker_;
 };
 
 // plan-path as a library: observations pass through and are remembered; each action passes

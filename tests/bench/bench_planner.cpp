@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
           goal.tcp_pose = base * robot.tcp_pose(q);
           const Eigen::Vector3d p = goal.tcp_pose.translation();
           if (p.z() > 0.80 && p.z() < 1.25 && p.x() > -0.1 && p.x() < 0.45 && std::abs(p.y()) < 0.35 &&
-              goal.tcp_pose.linear().col(2).z() < -0.3 && planner.state_valid(q, start.opening_m, nullptr))
+              goal.tcp_pose.linear().col(2).z() < -0.3 && planner.collisions().state_valid(q, start.opening_m, nullptr))
             break;
         }
         auto t0 = Clock::now();
