@@ -53,11 +53,11 @@ static void run(const cli::Arguments& args) {
   options.episodes.episodes = static_cast<int>(args.integer("episodes", 1, 1000000));
   options.episodes.variation = args.text("variation") == "random" ? -1 : static_cast<int>(args.integer("variation", 0, 1000));
   options.episodes.seed = args.seed();
-  options.episodes.scenes = simulator::scene_set_from_name(args.text("scenes"));
+  options.episodes.scenes = sim_step::scene_set_from_name(args.text("scenes"));
   options.retries = static_cast<int>(args.integer("retries", 0, 1000));
   options.planner.time_budget_s = args.real("time-budget", 0.001, 600);
   options.planner.seed = args.seed();
-  options.simulator = simulator::options_from_camera_arguments(args.text("cameras"), args.text("image-size"));
+  options.simulator = sim_step::options_from_camera_arguments(args.text("cameras"), args.text("image-size"));
   options.simulator.point_clouds = true;  // the planner needs them; dropped on output with --no-points
   options.simulator.compress_images = args.flag("compress");
   if (options.episodes.episodes < 1 || options.retries < 0) throw UsageError("--episodes >= 1 and --retries >= 0");

@@ -1,7 +1,7 @@
 // plan-path: next-best poses to collision-free joint trajectories on the sensed scene.
 #include "cli/command.hpp"
 #include "planning/motion_planner.hpp"
-#include "sim/scene_layout.hpp"
+#include "world/scene_layout.hpp"
 #include "stream/reader.hpp"
 #include "stream/writer.hpp"
 
@@ -63,7 +63,7 @@ static void run(const cli::Arguments& args) {
       !(options.max_acceleration_rad_s2 > 0) || !(options.scene.resolution_m >= 0.002))
     throw UsageError("--time-budget, --acceleration must be positive, --velocity-scale in (0, 1], --resolution >= 0.002");
   const robot::RobotModel robot = robot::RobotModel::xarm7();
-  const Eigen::Isometry3d world_from_base = sim::SceneLayout{}.robot_base_pose();
+  const Eigen::Isometry3d world_from_base = world::SceneLayout{}.robot_base_pose();
   planning::PlanPathFilter filter(robot, world_from_base, options);
   stream::RecordReader reader(args.positional().empty() ? "-" : args.positional()[0]);
   stream::RecordWriter writer(args.text("output"));

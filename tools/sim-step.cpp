@@ -2,7 +2,7 @@
 #include <unistd.h>
 
 #include "cli/command.hpp"
-#include "simulator/simulator.hpp"
+#include "sim_step/simulator.hpp"
 #include "stream/reader.hpp"
 #include "stream/writer.hpp"
 
@@ -66,8 +66,8 @@ static cli::Usage usage() {
 }
 
 static void run(const cli::Arguments& args) {
-  simulator::SimulatorOptions options =
-      simulator::options_from_camera_arguments(args.text("cameras"), args.text("image-size"));
+  sim_step::SimulatorOptions options =
+      sim_step::options_from_camera_arguments(args.text("cameras"), args.text("image-size"));
   options.observe_every_step = args.flag("every-step");
   options.point_clouds = !args.flag("no-points");
   options.compress_images = args.flag("compress");
@@ -75,18 +75,18 @@ static void run(const cli::Arguments& args) {
   if (options.render_threads < 1) throw UsageError("--threads must be at least 1");
 
   const robot::RobotModel robot = robot::RobotModel::xarm7();
-  simulator::Simulator simulator(robot, options);
-  std::optional<simulator::EpisodePlan> plan;
+  sim_step::Simulator simulator(robot, options);
+  std::optional<sim_step::EpisodePlan> plan;
   if (args.has("task")) {
-    plan = simulator::EpisodePlan{args.text("task"), 0, static_cast<int>(args.integer("episodes", 1, 10000000)), args.seed()};
+    plan = sim_step::EpisodePlan{args.text("task"), 0, static_cast<int>(args.integer("episodes", 1, 10000000)), args.seed()};
     plan->variation = args.text("variation") == "random" ? -1 : static_cast<int>(args.integer("variation", 0, 1000));
-    plan->scenes = simulator::scene_set_from_name(args.text("scenes"));
+    plan->scenes = sim_step::scene_set_from_name(args.text("scenes"));
     tasks::make_task(plan->task);  // an unknown task fails before anything is written
   }
   const std::string input = args.positional().empty() ? "-" : args.positional()[0];
   std::unique_ptr<stream::RecordReader> reader;
   stream::RecordWriter writer(args.text("output"));
-  simulator::run_filter(
+  sim_step::run_filter(
       simulator, plan,
       [&]() -> std::optional<stream::Record> {
         // Opened on demand: opening a FIFO blocks until its writer appears, and in the actor

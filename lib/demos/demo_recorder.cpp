@@ -15,7 +15,7 @@ struct Attempt {
   int variation = 0;
 };
 
-Attempt run_episode(simulator::Simulator& sim, planning::PlanPathFilter& planner, const stream::Record& reset) {
+Attempt run_episode(sim_step::Simulator& sim, planning::PlanPathFilter& planner, const stream::Record& reset) {
   Attempt attempt;
   attempt.seed = reset.scalar<int64_t>("seed");
   attempt.variation = reset.scalar<int32_t>("variation");
@@ -48,8 +48,8 @@ DemoSummary record_demos(const robot::RobotModel& robot, DemoOptions options,
                          const std::function<void(const std::string&)>& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   options.simulator.observe_every_step = true;
-  simulator::Simulator sim(robot, options.simulator);
-  planning::PlanPathFilter planner(robot, sim::SceneLayout{}.robot_base_pose(), options.planner);
+  sim_step::Simulator sim(robot, options.simulator);
+  planning::PlanPathFilter planner(robot, world::SceneLayout{}.robot_base_pose(), options.planner);
   DemoSummary summary;
   const int n = options.episodes.episodes;
   for (int e = 0; e < n; ++e) {
@@ -59,7 +59,7 @@ DemoSummary record_demos(const robot::RobotModel& robot, DemoOptions options,
     do {
       // Retries use seeds no first attempt uses: indices past the plan's episodes.
       const int index = attempts == 0 ? e : n + e * options.retries + attempts - 1;
-      attempt = run_episode(sim, planner, simulator::plan_reset(options.episodes, index));
+      attempt = run_episode(sim, planner, sim_step::plan_reset(options.episodes, index));
       ++attempts;
     } while (!attempt.success && attempts <= options.retries);
     for (const auto& r : attempt.records) emit(r);

@@ -6,13 +6,13 @@
 #include <string>
 
 #include "planning/motion_planner.hpp"
-#include "simulator/simulator.hpp"
+#include "sim_step/simulator.hpp"
 
 namespace qte::demos {
 
 struct DemoOptions {
-  simulator::EpisodePlan episodes;
-  simulator::SimulatorOptions simulator;  // observe_every_step is forced on
+  sim_step::EpisodePlan episodes;
+  sim_step::SimulatorOptions simulator;  // observe_every_step is forced on
   planning::PlannerOptions planner;
   int retries = 0;  // new seeds tried for an episode whose expert failed
 };

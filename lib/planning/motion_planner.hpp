@@ -16,7 +16,7 @@
 #include "planning/collision_checker.hpp"
 #include "planning/occupancy_scene.hpp"
 #include "planning/robot_spheres.hpp"
-#include "sim/scene_layout.hpp"
+#include "world/scene_layout.hpp"
 #include "robot/inverse_kinematics.hpp"
 #include "stream/record.hpp"
 
@@ -31,7 +31,7 @@ struct PlannerOptions {
   double check_step_rad = 0.02;        // collision checks along motions, largest joint step
   double straight_step_m = 0.01;       // TCP step of straight-line moves
   double goal_free_radius_m = 0.06;    // around the goal TCP, points are not obstacles
-  double table_height_m = sim::SceneLayout::kTableHeight_m;  // under the table top (unseen) is never free
+  double table_height_m = world::SceneLayout::kTableHeight_m;  // under the table top (unseen) is never free
   uint64_t seed = 0;
   SceneOptions scene;
 };

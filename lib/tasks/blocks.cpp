@@ -4,11 +4,11 @@
 
 namespace qte::tasks {
 
-sim::ObjectSpec block(const sim::World& world, const std::string& name, const Eigen::Vector3d& xy,
+world::ObjectSpec block(const world::World& world, const std::string& name, const Eigen::Vector3d& xy,
                       double yaw_rad, const Eigen::Vector3f& colour) {
-  sim::ObjectSpec spec;
+  world::ObjectSpec spec;
   spec.name = name;
-  spec.shape = sim::ObjectSpec::Shape::box;
+  spec.shape = world::ObjectSpec::Shape::box;
   spec.size = Eigen::Vector3d::Constant(kBlockSize);
   spec.pose.linear() = Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   spec.pose.translation() << xy.x(), xy.y(), world.layout().table_height_m + kBlockSize / 2;
@@ -17,7 +17,7 @@ sim::ObjectSpec block(const sim::World& world, const std::string& name, const Ei
   return spec;
 }
 
-std::vector<Waypoint> grasp_and_lift(const sim::World& world, int block_id, double lift_m) {
+std::vector<Waypoint> grasp_and_lift(const world::World& world, int block_id, double lift_m) {
   const Eigen::Isometry3d pose = world.object_pose(block_id);
   // Fingers close across two opposite faces: the block's yaw modulo a quarter turn.
   const Eigen::Vector3d x_axis = pose.linear().col(0);
@@ -45,10 +45,10 @@ std::vector<Waypoint> place_at(const Eigen::Vector3d& resting_centre, double yaw
   return {over, place, retreat};  // place.gripper_open: opened on arrival
 }
 
-sim::ObjectSpec success_zone(const sim::World& world, const Eigen::Vector3d& xy, double radius) {
-  sim::ObjectSpec zone;
+world::ObjectSpec success_zone(const world::World& world, const Eigen::Vector3d& xy, double radius) {
+  world::ObjectSpec zone;
   zone.name = "success_zone";
-  zone.shape = sim::ObjectSpec::Shape::sphere;
+  zone.shape = world::ObjectSpec::Shape::sphere;
   zone.size = Eigen::Vector3d(radius, 0, 0);
   zone.pose.translation() << xy.x(), xy.y(), world.layout().table_height_m + 0.3;
   zone.mass_kg = 0;
@@ -58,7 +58,7 @@ sim::ObjectSpec success_zone(const sim::World& world, const Eigen::Vector3d& xy,
   return zone;
 }
 
-std::vector<Waypoint> lift_into_zone(const sim::World& world, int object_id) {
+std::vector<Waypoint> lift_into_zone(const world::World& world, int object_id) {
   auto waypoints = grasp_and_lift(world, object_id, 0.15);
   Waypoint into_zone = waypoints.back();
   into_zone.tcp_pose.translation() = world.object_pose(world.object_id("success_zone")).translation();
@@ -67,7 +67,7 @@ std::vector<Waypoint> lift_into_zone(const sim::World& world, int object_id) {
   return waypoints;
 }
 
-bool held_in_zone(const sim::World& world, int object_id, double radius) {
+bool held_in_zone(const world::World& world, int object_id, double radius) {
   const Eigen::Vector3d zone = world.object_pose(world.object_id("success_zone")).translation();
   return world.held_object() == object_id && (world.object_pose(object_id).translation() - zone).norm() <= radius;
 }

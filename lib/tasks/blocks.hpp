@@ -9,12 +9,12 @@ namespace qte::tasks {
 constexpr double kBlockSize = 0.05;
 
 // A block resting on the table at (x, y) with yaw `yaw_rad`.
-sim::ObjectSpec block(const sim::World& world, const std::string& name, const Eigen::Vector3d& xy,
+world::ObjectSpec block(const world::World& world, const std::string& name, const Eigen::Vector3d& xy,
                       double yaw_rad, const Eigen::Vector3f& colour);
 
 // Pre-grasp above the block, grasp at its centre (gripper closes), then lift straight up by
 // `lift_m`: the first three waypoints of every pick task.
-std::vector<Waypoint> grasp_and_lift(const sim::World& world, int block_id, double lift_m);
+std::vector<Waypoint> grasp_and_lift(const world::World& world, int block_id, double lift_m);
 
 // Placing the held object: over `resting_centre` (where its centre will rest) by `above_m`,
 // down to 5 mm over it, the gripper opening there (released; physics settles it), back up;
@@ -22,10 +22,10 @@ std::vector<Waypoint> grasp_and_lift(const sim::World& world, int block_id, doub
 std::vector<Waypoint> place_at(const Eigen::Vector3d& resting_centre, double yaw_rad, double above_m);
 
 // The green sphere an object is lifted into, 0.3 m above the table at (x, y); seen, not felt.
-sim::ObjectSpec success_zone(const sim::World& world, const Eigen::Vector3d& xy, double radius);
+world::ObjectSpec success_zone(const world::World& world, const Eigen::Vector3d& xy, double radius);
 // grasp_and_lift by 15 cm, then into the scene's "success_zone".
-std::vector<Waypoint> lift_into_zone(const sim::World& world, int object_id);
+std::vector<Waypoint> lift_into_zone(const world::World& world, int object_id);
 // The object is held and its centre inside the scene's "success_zone" of `radius`.
-bool held_in_zone(const sim::World& world, int object_id, double radius);
+bool held_in_zone(const world::World& world, int object_id, double radius);
 
 }  // namespace qte::tasks

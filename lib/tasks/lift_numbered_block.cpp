@@ -16,7 +16,7 @@ class LiftNumberedBlock : public Task {
     return "lift the block numbered " + std::to_string(variation + 1);
   }
 
-  void build(sim::World& world, int variation, std::mt19937_64& rng) override {
+  void build(world::World& world, int variation, std::mt19937_64& rng) override {
     const auto positions = sample_separated(rng, 3, {kRegionMinX, kRegionMinY, 0},
                                             {kRegionMaxX, kRegionMaxY, 0}, 0.2);
     const Eigen::Vector3f paper(0.95f, 0.95f, 0.95f), ink(0.05f, 0.05f, 0.05f);
@@ -24,7 +24,7 @@ class LiftNumberedBlock : public Task {
     for (int digit = 1; digit <= 3; ++digit) {
       // Yaw near a quarter turn: the top face's image "up" (object +y) then points away
       // from the front camera, so the digit reads upright in its image.
-      sim::ObjectSpec spec = block(world, "block" + std::to_string(digit), positions[digit - 1],
+      world::ObjectSpec spec = block(world, "block" + std::to_string(digit), positions[digit - 1],
                                    M_PI / 2 + yaw(rng), paper);
       const cv::Mat texture = render::text_texture(std::to_string(digit), 64, paper, ink);
       for (int face = 0; face < 5; ++face) spec.appearance.box_face_textures[face] = texture;
@@ -33,14 +33,14 @@ class LiftNumberedBlock : public Task {
     target_ = "block" + std::to_string(variation + 1);
   }
 
-  bool success(const sim::World& world) const override {
+  bool success(const world::World& world) const override {
     const int target = world.object_id(target_);
     const double bottom = world.object_pose(target).translation().z() - kBlockSize / 2;
     return world.held_object() == target &&
            bottom >= world.layout().table_height_m + kLiftHeight - 0.01;
   }
 
-  std::vector<Waypoint> expert_waypoints(const sim::World& world) const override {
+  std::vector<Waypoint> expert_waypoints(const world::World& world) const override {
     return grasp_and_lift(world, world.object_id(target_), kLiftHeight + 0.02);
   }
 

@@ -15,7 +15,7 @@ class PickAndLift : public Task {
     return "pick up the " + colours()[variation].name + " block and lift it up to the target";
   }
 
-  void build(sim::World& world, int variation, std::mt19937_64& rng) override {
+  void build(world::World& world, int variation, std::mt19937_64& rng) override {
     // Three blocks and, above the table, the zone: apart in plan view, so the arm over a
     // block never reaches into the zone (which a camera-based planner sees as an obstacle).
     const auto positions = sample_separated(rng, 4, {kRegionMinX, kRegionMinY, 0},
@@ -29,11 +29,11 @@ class PickAndLift : public Task {
     world.add_object(success_zone(world, positions[3], kZoneRadius));
   }
 
-  bool success(const sim::World& world) const override {
+  bool success(const world::World& world) const override {
     return held_in_zone(world, world.object_id("target"), kZoneRadius);
   }
 
-  std::vector<Waypoint> expert_waypoints(const sim::World& world) const override {
+  std::vector<Waypoint> expert_waypoints(const world::World& world) const override {
     return lift_into_zone(world, world.object_id("target"));
   }
 };

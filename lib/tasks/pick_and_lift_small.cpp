@@ -33,7 +33,7 @@ class PickAndLiftSmall : public Task {
            " and lift it up to the target";
   }
 
-  void build(sim::World& world, int variation, std::mt19937_64& rng) override {
+  void build(world::World& world, int variation, std::mt19937_64& rng) override {
     target_ = kShapes[variation];
     // The shapes 10 cm apart; the zone (above the table) 15 cm from each in plan view, so the
     // arm over a shape never reaches into it (the planner sees it as an obstacle).
@@ -43,8 +43,8 @@ class PickAndLiftSmall : public Task {
     std::uniform_real_distribution<double> yaw(-M_PI, M_PI);
     const Eigen::Vector3f colour(0.2f, 0.45f, 0.95f);
     for (int i = 0; i < 5; ++i) {
-      sim::ObjectSpec spec = standing_prism(world, kShapes[i], footprint(kShapes[i]), kSize, positions[i], yaw(rng), colour);
-      spec.pose.translation().z() += sim::kHullMargin;  // resting on its margin
+      world::ObjectSpec spec = standing_prism(world, kShapes[i], footprint(kShapes[i]), kSize, positions[i], yaw(rng), colour);
+      spec.pose.translation().z() += world::kHullMargin;  // resting on its margin
       spec.mass_kg = 0.03;
       spec.graspable = true;
       world.add_object(spec);
@@ -52,11 +52,11 @@ class PickAndLiftSmall : public Task {
     world.add_object(success_zone(world, zone_xy, kZoneRadius));
   }
 
-  bool success(const sim::World& world) const override {
+  bool success(const world::World& world) const override {
     return held_in_zone(world, world.object_id(target_), kZoneRadius);
   }
 
-  std::vector<Waypoint> expert_waypoints(const sim::World& world) const override {
+  std::vector<Waypoint> expert_waypoints(const world::World& world) const override {
     return lift_into_zone(world, world.object_id(target_));
   }
 

@@ -20,7 +20,7 @@ class ReachPrism : public Task {
   int variation_count() const override { return 1; }
   std::string description(int) const override { return "reach the pentagonal prism"; }
 
-  void build(sim::World& world, int, std::mt19937_64& rng) override {
+  void build(world::World& world, int, std::mt19937_64& rng) override {
     const auto positions = sample_separated(rng, 3, {kRegionMinX, kRegionMinY, 0}, {kRegionMaxX, kRegionMaxY, 0}, 0.1);
     std::uniform_real_distribution<double> yaw(-M_PI, M_PI);
     // Footprints 4.0-4.3 cm across: the pentagon's 2.1 cm circumradius, the triangle's 2.5 cm
@@ -35,11 +35,11 @@ class ReachPrism : public Task {
     prism("cube", 4, 0.03 / std::sqrt(2.0), positions[2]);
   }
 
-  bool success(const sim::World& world) const override {
+  bool success(const world::World& world) const override {
     return (world.tcp_pose().translation() - reach_point(world)).norm() <= kReachRadius;
   }
 
-  std::vector<Waypoint> expert_waypoints(const sim::World& world) const override {
+  std::vector<Waypoint> expert_waypoints(const world::World& world) const override {
     Waypoint reach;
     reach.tcp_pose.linear() = top_down(0);
     reach.tcp_pose.translation() = reach_point(world);
@@ -47,7 +47,7 @@ class ReachPrism : public Task {
   }
 
  private:
-  static Eigen::Vector3d reach_point(const sim::World& world) {
+  static Eigen::Vector3d reach_point(const world::World& world) {
     return world.object_pose(world.object_id("prism")).translation() +
            Eigen::Vector3d(0, 0, kHeight / 2 + kReachAbove);
   }

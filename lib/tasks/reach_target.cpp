@@ -15,7 +15,7 @@ class ReachTarget : public Task {
     return "reach the " + colours()[variation].name + " target";
   }
 
-  void build(sim::World& world, int variation, std::mt19937_64& rng) override {
+  void build(world::World& world, int variation, std::mt19937_64& rng) override {
     const double table = world.layout().table_height_m;
     // Distractors never hover right above the target: the expert reaches it from above.
     std::vector<Eigen::Vector3d> positions;
@@ -28,9 +28,9 @@ class ReachTarget : public Task {
     } while (above_target(positions[1]) || above_target(positions[2]));
     const auto distractor_colours = pick_distinct(rng, 2, variation_count(), variation);
     for (int i = 0; i < 3; ++i) {
-      sim::ObjectSpec sphere;
+      world::ObjectSpec sphere;
       sphere.name = i == 0 ? "target" : "distractor" + std::to_string(i);
-      sphere.shape = sim::ObjectSpec::Shape::sphere;
+      sphere.shape = world::ObjectSpec::Shape::sphere;
       sphere.size = Eigen::Vector3d(kRadius, 0, 0);
       sphere.pose.translation() = positions[i];
       sphere.mass_kg = 0;  // floats where it was placed
@@ -41,12 +41,12 @@ class ReachTarget : public Task {
     }
   }
 
-  bool success(const sim::World& world) const override {
+  bool success(const world::World& world) const override {
     const Eigen::Vector3d target = world.object_pose(world.object_id("target")).translation();
     return (world.tcp_pose().translation() - target).norm() <= kRadius;
   }
 
-  std::vector<Waypoint> expert_waypoints(const sim::World& world) const override {
+  std::vector<Waypoint> expert_waypoints(const world::World& world) const override {
     Waypoint reach;
     reach.tcp_pose.linear() = top_down(0);
     reach.tcp_pose.translation() = world.object_pose(world.object_id("target")).translation();

@@ -29,13 +29,13 @@ class SetupCheckers : public Task {
     return "place the " + std::to_string(variation + 1) + " checker" + (variation ? "s" : "") + " on the board";
   }
 
-  void build(sim::World& world, int variation, std::mt19937_64& rng) override {
+  void build(world::World& world, int variation, std::mt19937_64& rng) override {
     const double table = world.layout().table_height_m;
     auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
     Eigen::Isometry3d board = Eigen::Isometry3d::Identity();
     board.linear() = Eigen::AngleAxisd(uniform(-0.15, 0.15), Eigen::Vector3d::UnitZ()).toRotationMatrix();
     board.translation() << uniform(0.10, 0.14), uniform(-0.03, 0.03), table + kBoardThickness / 2;
-    sim::ObjectSpec spec;
+    world::ObjectSpec spec;
     spec.name = "board";
     spec.size = Eigen::Vector3d(8 * kSquare, 8 * kSquare, kBoardThickness);
     spec.pose = board;
@@ -51,7 +51,7 @@ class SetupCheckers : public Task {
       for (int column = 0; column < 8; ++column)
         if ((row + column) % 2 == 0) {
           const Eigen::Vector3d square((column - 3.5) * kSquare, (row - 3.5) * kSquare,
-                                       kBoardThickness / 2 + sim::kHullMargin + kCheckerHeight / 2);
+                                       kBoardThickness / 2 + world::kHullMargin + kCheckerHeight / 2);
           homes_.push_back({(row < 4 ? "red" : "black") + std::to_string(homes_.size() % 12), square});
         }
     std::vector<int> order(homes_.size());
@@ -63,14 +63,14 @@ class SetupCheckers : public Task {
     for (std::size_t i = 0; i < homes_.size(); ++i) {
       // A 24-sided prism rather than Bullet's cylinder: thin cylinders stacked on one
       // another slide apart in Bullet within a second (their margin is 0.36 mm); hulls rest.
-      sim::ObjectSpec checker = standing_prism(world, homes_[i].first, {regular_polygon(24, kCheckerRadius)},
+      world::ObjectSpec checker = standing_prism(world, homes_[i].first, {regular_polygon(24, kCheckerRadius)},
                                                kCheckerHeight, Eigen::Vector3d::Zero(), 0, Eigen::Vector3f::Zero());
       checker.pose.linear() = board.linear();
       const auto stacked = std::find(off_board_.begin(), off_board_.end(), static_cast<int>(i));
       checker.pose.translation() = stacked == off_board_.end()
           ? board * homes_[i].second
-          : spot + Eigen::Vector3d(0, 0, (stacked - off_board_.begin()) * (kCheckerHeight + 2 * sim::kHullMargin) +
-                                               sim::kHullMargin + kCheckerHeight / 2);
+          : spot + Eigen::Vector3d(0, 0, (stacked - off_board_.begin()) * (kCheckerHeight + 2 * world::kHullMargin) +
+                                               world::kHullMargin + kCheckerHeight / 2);
       checker.mass_kg = 0.01;
       checker.graspable = true;
       checker.appearance.colour = homes_[i].first[0] == 'r' ? Eigen::Vector3f(0.8f, 0.1f, 0.1f) : Eigen::Vector3f(0.12f, 0.12f, 0.12f);
@@ -79,7 +79,7 @@ class SetupCheckers : public Task {
   }
 
   // Every checker resting on its own square, nothing held.
-  bool success(const sim::World& world) const override {
+  bool success(const world::World& world) const override {
     if (world.held_object() >= 0) return false;
     const Eigen::Isometry3d board = world.object_pose(world.object_id("board"));
     for (const auto& [name, square] : homes_) {
@@ -89,7 +89,7 @@ class SetupCheckers : public Task {
     return true;
   }
 
-  std::vector<Waypoint> expert_waypoints(const sim::World& world) const override {
+  std::vector<Waypoint> expert_waypoints(const world::World& world) const override {
     const Eigen::Isometry3d board = world.object_pose(world.object_id("board"));
     const double yaw = std::atan2(board.linear()(1, 0), board.linear()(0, 0));
     std::vector<Waypoint> waypoints;

@@ -48,10 +48,10 @@ std::vector<Polygon> crescent_pieces(double radius, double offset, int slices) {
   return pieces;
 }
 
-sim::ObjectSpec standing_prism(const sim::World& world, const std::string& name,
+world::ObjectSpec standing_prism(const world::World& world, const std::string& name,
                                const std::vector<Polygon>& footprint, double height,
                                const Eigen::Vector3d& xy, double yaw_rad, const Eigen::Vector3f& colour) {
-  sim::ObjectSpec spec;
+  world::ObjectSpec spec;
   spec.name = name;
   for (const Polygon& polygon : footprint) {
     std::vector<Eigen::Vector3d> piece;
@@ -60,11 +60,11 @@ sim::ObjectSpec standing_prism(const sim::World& world, const std::string& name,
     spec.pieces.push_back(piece);
   }
   if (spec.pieces.size() == 1) {
-    spec.shape = sim::ObjectSpec::Shape::convex_hull;
+    spec.shape = world::ObjectSpec::Shape::convex_hull;
     spec.hull_points = spec.pieces.front();
     spec.pieces.clear();
   } else {
-    spec.shape = sim::ObjectSpec::Shape::compound;
+    spec.shape = world::ObjectSpec::Shape::compound;
   }
   spec.pose.linear() = Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   spec.pose.translation() << xy.x(), xy.y(), world.layout().table_height_m + height / 2;

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/world.hpp"
+#include "world/world.hpp"
 
 namespace qte::tasks {
 
@@ -25,7 +25,7 @@ std::vector<Polygon> crescent_pieces(double radius, double offset, int slices);
 
 // The prism of `height` over `footprint` standing on the table at (x, y) with yaw `yaw_rad`;
 // static and not graspable until the caller says otherwise.
-sim::ObjectSpec standing_prism(const sim::World& world, const std::string& name,
+world::ObjectSpec standing_prism(const world::World& world, const std::string& name,
                                const std::vector<Polygon>& footprint, double height,
                                const Eigen::Vector3d& xy, double yaw_rad, const Eigen::Vector3f& colour);
 

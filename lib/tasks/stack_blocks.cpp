@@ -25,7 +25,7 @@ class StackBlocks : public Task {
     return "stack " + std::to_string(height(variation)) + " " + colours()[variation / 3].name + " blocks";
   }
 
-  void build(sim::World& world, int variation, std::mt19937_64& rng) override {
+  void build(world::World& world, int variation, std::mt19937_64& rng) override {
     stack_ = height(variation);
     // Nine places 10 cm apart: too dense for joint rejection sampling, so one at a time.
     const auto positions = place_one_by_one(rng, 2 * kPerColour + 1, {kRegionMinX, kRegionMinY, 0},
@@ -37,7 +37,7 @@ class StackBlocks : public Task {
       const std::string name = (target ? "target" : "distractor") + std::to_string(i % kPerColour + 1);
       world.add_object(block(world, name, positions[i], yaw(rng), colours()[target ? variation / 3 : other].rgb));
     }
-    sim::ObjectSpec plane;
+    world::ObjectSpec plane;
     plane.name = "target_plane";
     plane.size = Eigen::Vector3d(kPlaneSize, kPlaneSize, 0.002);
     plane.pose.translation() << positions.back().x(), positions.back().y(), world.layout().table_height_m + 0.001;
@@ -50,7 +50,7 @@ class StackBlocks : public Task {
 
   // Target blocks over the plane, from the bottom: one on each level, the stack as high as
   // asked, and nothing held.
-  bool success(const sim::World& world) const override {
+  bool success(const world::World& world) const override {
     if (world.held_object() >= 0) return false;
     const Eigen::Vector3d plane = world.object_pose(world.object_id("target_plane")).translation();
     const double table = world.layout().table_height_m;
@@ -66,7 +66,7 @@ class StackBlocks : public Task {
     return true;
   }
 
-  std::vector<Waypoint> expert_waypoints(const sim::World& world) const override {
+  std::vector<Waypoint> expert_waypoints(const world::World& world) const override {
     const Eigen::Vector3d plane = world.object_pose(world.object_id("target_plane")).translation();
     const double table = world.layout().table_height_m;
     std::vector<Waypoint> waypoints;

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/world.hpp"
+#include "world/world.hpp"
 #include "tasks/episode.hpp"
 
 namespace qte::tasks {
@@ -29,9 +29,9 @@ class Task {
   // In words, for people and logs, e.g. "lift the block numbered 2".
   virtual std::string description(int variation) const = 0;
   // Adds the task's objects to an empty world, randomised by `rng`.
-  virtual void build(sim::World& world, int variation, std::mt19937_64& rng) = 0;
-  virtual bool success(const sim::World& world) const = 0;
-  virtual std::vector<Waypoint> expert_waypoints(const sim::World& world) const = 0;
+  virtual void build(world::World& world, int variation, std::mt19937_64& rng) = 0;
+  virtual bool success(const world::World& world) const = 0;
+  virtual std::vector<Waypoint> expert_waypoints(const world::World& world) const = 0;
 
   // Next-best poses per episode: the published 10, more where the expert needs more
   // (its keyframes plus slack). The 'obs' records carry it as episode_length.

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "planning/motion_planner.hpp"
-#include "simulator/simulator.hpp"
+#include "sim_step/simulator.hpp"
 
 using namespace qte;
 using Clock = std::chrono::steady_clock;
@@ -26,7 +26,7 @@ static double seconds_since(Clock::time_point t) { return std::chrono::duration<
 int main(int argc, char** argv) {
   std::FILE* decisions = argc == 3 && std::string(argv[1]) == "--decisions" ? std::fopen(argv[2], "w") : nullptr;
   const robot::RobotModel robot = robot::RobotModel::xarm7();
-  const Eigen::Isometry3d base = sim::SceneLayout{}.robot_base_pose();
+  const Eigen::Isometry3d base = world::SceneLayout{}.robot_base_pose();
   std::mt19937 rng(11);
 
   // IK from the ready pose to random reachable targets.
@@ -53,10 +53,10 @@ int main(int argc, char** argv) {
   int goals = 0;
   for (const char* task : {"pick_and_lift", "lift_numbered_block", "reach_target"}) {
     for (int scene_index = 0; scene_index < (std::string(task) == "reach_target" ? 2 : 4); ++scene_index) {
-      simulator::SimulatorOptions options;
-      simulator::Simulator sim(robot, options);
+      sim_step::SimulatorOptions options;
+      sim_step::Simulator sim(robot, options);
       stream::Record obs("obs");
-      sim.handle(simulator::plan_reset({task, 0, 10, 3}, scene_index), [&](const stream::Record& r) { obs = r; });
+      sim.handle(sim_step::plan_reset({task, 0, 10, 3}, scene_index), [&](const stream::Record& r) { obs = r; });
       planning::MotionPlanner planner(robot, base);
       const planning::StartState start = planning::start_state_from(obs);
       for (int g = 0; g < 20; ++g) {

@@ -16,7 +16,7 @@
 #include <random>
 
 #include "planning/occupancy_scene.hpp"
-#include "simulator/simulator.hpp"
+#include "sim_step/simulator.hpp"
 
 using namespace qte;
 using namespace qte::planning;
@@ -43,9 +43,9 @@ struct Frame {
 };
 
 Frame observe(const robot::RobotModel& robot, const RobotSpheres& spheres, int size) {
-  simulator::SimulatorOptions options;
+  sim_step::SimulatorOptions options;
   options.cameras[0].intrinsics.width = options.cameras[0].intrinsics.height = size;
-  simulator::Simulator simulator(robot, options);
+  sim_step::Simulator simulator(robot, options);
   Frame frame;
   stream::Record reset("reset");
   reset.set_string("task", "pick_and_lift");
@@ -205,7 +205,7 @@ int main() {
   // Whole-robot checks at random joint states (placed beforehand; placing is timed apart).
   const robot::JointVector lo = robot.lower_limits(), hi = robot.upper_limits();
   Eigen::Isometry3d base = Eigen::Isometry3d::Identity();
-  base.translation() = sim::SceneLayout{}.robot_base;
+  base.translation() = world::SceneLayout{}.robot_base;
   std::vector<robot::JointVector> states(2000);
   for (auto& q : states)
     for (int k = 0; k < robot::kArmJoints; ++k) q[k] = std::uniform_real_distribution<double>(lo[k], hi[k])(rng);

@@ -5,7 +5,7 @@
 
 #include "common/random.hpp"
 #include "robot/inverse_kinematics.hpp"
-#include "simulator/simulator.hpp"
+#include "sim_step/simulator.hpp"
 
 using namespace qte;
 using Clock = std::chrono::steady_clock;
@@ -17,29 +17,29 @@ static double seconds_since(Clock::time_point t) {
 int main() {
   const robot::RobotModel robot = robot::RobotModel::xarm7();
   {
-    simulator::SimulatorOptions options;
-    simulator::Simulator simulator(robot, options);
-    simulator.handle(simulator::plan_reset({"pick_and_lift", 0, 1, 0}, 0), [](const stream::Record&) {});
-    sim::World& world = *simulator.world();
+    sim_step::SimulatorOptions options;
+    sim_step::Simulator simulator(robot, options);
+    simulator.handle(sim_step::plan_reset({"pick_and_lift", 0, 1, 0}, 0), [](const stream::Record&) {});
+    world::World& world = *simulator.world();
     const int steps = 4800;
     const auto t0 = Clock::now();
-    world.settle(steps * sim::World::kPhysicsStep);
+    world.settle(steps * world::World::kPhysicsStep);
     const double s = seconds_since(t0);
     std::printf("physics pick_and_lift scene: %.0f steps/s (%.1f x real time at 240 Hz)\n", steps / s,
                 steps / s / 240.0);
   }
   for (const char* task : {"reach_target", "pick_and_lift", "lift_numbered_block"}) {
     for (int size : {128, 256}) {
-      simulator::SimulatorOptions options;
+      sim_step::SimulatorOptions options;
       options.cameras[0].intrinsics.width = options.cameras[0].intrinsics.height = size;
-      simulator::Simulator simulator(robot, options);
+      sim_step::Simulator simulator(robot, options);
       double reset_s = 0, step_s = 0, trajectory_s = 0;
       const int episodes = 5;
       for (int e = 0; e < episodes; ++e) {
         auto t0 = Clock::now();
-        simulator.handle(simulator::plan_reset({task, 0, episodes, 7}, e), [](const stream::Record&) {});
+        simulator.handle(sim_step::plan_reset({task, 0, episodes, 7}, e), [](const stream::Record&) {});
         reset_s += seconds_since(t0);
-        sim::World& world = *simulator.world();
+        world::World& world = *simulator.world();
         const auto waypoint = simulator.task()->expert_waypoints(world).front();
         const auto q = robot::solve_ik(robot, world.robot_base_pose().inverse() * waypoint.tcp_pose,
                                        world.joint_positions());

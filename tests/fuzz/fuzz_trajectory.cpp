@@ -3,14 +3,14 @@
 // Run: make fuzz.
 #include "fuzz_support.hpp"
 #include "robot/robot_model.hpp"
-#include "simulator/simulator.hpp"
+#include "sim_step/simulator.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const qte::robot::RobotModel robot = qte::robot::RobotModel::xarm7();
-  qte::simulator::SimulatorOptions options = qte::simulator::options_from_camera_arguments("front", "16x16");
+  qte::sim_step::SimulatorOptions options = qte::sim_step::options_from_camera_arguments("front", "16x16");
   options.max_trajectory_s = 1.0;
   options.render_threads = 1;
-  qte::simulator::Simulator simulator(robot, options);
+  qte::sim_step::Simulator simulator(robot, options);
   qte::fuzz::for_each_record(data, size, [&](const qte::stream::Record& record) {
     simulator.handle(record, [](const qte::stream::Record&) {});
   });

@@ -119,10 +119,10 @@ TEST_P(ExpertKeyframes, MatchTheExpertsWaypoints) {
   demos::record_demos(robot, options, [&](const stream::Record& r) { records.push_back(r); },
                       [](const std::string&) {});
   // The expert's waypoints of each episode, from a simulator reset the same way.
-  simulator::Simulator sim(robot, options.simulator);
+  sim_step::Simulator sim(robot, options.simulator);
   std::size_t at = 0;
   for (int e = 0; e < 3; ++e) {
-    sim.handle(simulator::plan_reset(options.episodes, e), [](const stream::Record&) {});
+    sim.handle(sim_step::plan_reset(options.episodes, e), [](const stream::Record&) {});
     const auto waypoints = sim.task()->expert_waypoints(*sim.world());
     std::vector<FrameState> states;
     std::vector<Eigen::Vector3d> positions;

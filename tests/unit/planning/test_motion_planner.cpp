@@ -7,7 +7,7 @@
 
 #include "planning/motion_planner.hpp"
 #include "planning/time_parametrization.hpp"
-#include "simulator/simulator.hpp"
+#include "sim_step/simulator.hpp"
 #include "test_support.hpp"
 
 using namespace qte;
@@ -18,8 +18,8 @@ namespace {
 using test_support::xarm;
 
 struct Scene {
-  simulator::Simulator sim{xarm(), [] {
-                             simulator::SimulatorOptions o;
+  sim_step::Simulator sim{xarm(), [] {
+                             sim_step::SimulatorOptions o;
                              o.render_threads = 1;
                              return o;
                            }()};
@@ -30,7 +30,7 @@ struct Scene {
     reset.set_scalar<int64_t>("seed", seed);
     sim.handle(reset, [&](const stream::Record& r) { obs = r; });
   }
-  sim::World& world() { return *sim.world(); }
+  world::World& world() { return *sim.world(); }
 };
 
 Goal pose_goal(const Eigen::Vector3d& p, double yaw = 0) {
@@ -41,7 +41,7 @@ Goal pose_goal(const Eigen::Vector3d& p, double yaw = 0) {
 }
 
 // Replays a trajectory in the Bullet world at the physics rate; the first contact, or "".
-std::string first_contact(sim::World& world, const PlanResult& plan) {
+std::string first_contact(world::World& world, const PlanResult& plan) {
   for (std::size_t i = 1; i < plan.joint_positions.size(); ++i) {
     const int steps = 8;
     for (int s = 1; s <= steps; ++s) {
@@ -169,7 +169,7 @@ TEST(MotionPlanner, ActionRecordsAreValidated) {
   obs.set<double>("joint_positions", {7}, std::vector<double>(7, 0.0));
   obs.set_scalar<double>("gripper_opening_m", 0.085);
   obs.set_scalar<uint8_t>("gripper_open", 1);
-  MotionPlanner planner(xarm(), sim::SceneLayout{}.robot_base_pose());
+  MotionPlanner planner(xarm(), world::SceneLayout{}.robot_base_pose());
   EXPECT_THROW(planner.scene_from(obs, start_state_from(obs)), StreamError);  // no point cloud
 
   // A camera pose with a NaN: an error naming the field, not a scene seen from nowhere.

@@ -12,7 +12,7 @@
 #include <sstream>
 
 #include "planning/occupancy_scene.hpp"
-#include "simulator/simulator.hpp"
+#include "sim_step/simulator.hpp"
 #include "test_support.hpp"
 
 using namespace qte;
@@ -34,11 +34,11 @@ struct Observation {
 
 const Observation& observation() {
   static const Observation o = [] {
-    simulator::SimulatorOptions options;
+    sim_step::SimulatorOptions options;
     options.cameras = {{"front", {}}};
     options.cameras[0].intrinsics.width = options.cameras[0].intrinsics.height = 128;
     options.render_threads = 1;
-    simulator::Simulator simulator(xarm(), options);
+    sim_step::Simulator simulator(xarm(), options);
     stream::Record reset("reset");
     reset.set_string("task", "pick_and_lift");
     reset.set_scalar<int32_t>("variation", 0);
@@ -49,7 +49,7 @@ const Observation& observation() {
     out.camera_origin << extrinsics[3], extrinsics[7], extrinsics[11];
     robot::JointVector q;
     for (int k = 0; k < robot::kArmJoints; ++k) q[k] = out.obs.array<double>("joint_positions")[k];
-    const sim::World& world = *simulator.world();
+    const world::World& world = *simulator.world();
     static const RobotSpheres spheres(xarm());
     spheres.place(q, out.obs.scalar<double>("gripper_opening_m"), world.robot_base_pose(), out.robot);
     for (const char* name : {"target", "distractor1", "distractor2"})
@@ -210,13 +210,13 @@ struct SeenScene {
 };
 
 SeenScene seen_by(const std::vector<std::string>& cameras) {
-  simulator::SimulatorOptions options;
+  sim_step::SimulatorOptions options;
   options.cameras.clear();
   for (const auto& name : cameras) {
     options.cameras.push_back({name, {}});
     options.cameras.back().intrinsics.width = options.cameras.back().intrinsics.height = 96;
   }
-  simulator::Simulator simulator(xarm(), options);
+  sim_step::Simulator simulator(xarm(), options);
   stream::Record reset("reset"), obs("obs");
   reset.set_string("task", "pick_and_lift");
   reset.set_scalar<int32_t>("variation", 0);

@@ -7,7 +7,7 @@
 
 #include "common/error.hpp"
 #include "planning/robot_spheres.hpp"
-#include "sim/world.hpp"
+#include "world/world.hpp"
 #include "test_support.hpp"
 
 using namespace qte;
@@ -134,9 +134,9 @@ TEST(RobotSpheres, SelfCollisionAtTheReadyPoseAndWhenFolded) {
 TEST(RobotSpheres, SelfCollisionIsConservativeAgainstTheBulletWorld) {
   // Every self-collision the Bullet world finds, the spheres (margin 0) find too: they cover
   // the primitives. The base stands high above the table, so only self-contacts are found.
-  sim::SceneLayout layout;
+  world::SceneLayout layout;
   layout.robot_base.z() = 3.0;
-  sim::World world(xarm(), layout);
+  world::World world(xarm(), layout);
   const RobotSpheres spheres(xarm());
   std::mt19937 rng(11);
   const robot::JointVector lo = xarm().lower_limits(), hi = xarm().upper_limits();

@@ -9,14 +9,14 @@
 #include <random>
 #include <string>
 
-#include "simulator/trajectory_helpers.hpp"
+#include "sim_step/trajectory_helpers.hpp"
 #include "tasks/task.hpp"
 #include "test_support.hpp"
 
 namespace qte::test_support {
 
 struct TaskScene {
-  sim::World world{xarm()};
+  world::World world{xarm()};
   std::unique_ptr<tasks::Task> task;
   TaskScene(const std::string& name, uint64_t seed, int variation) : task(tasks::make_task(name)) {
     std::mt19937_64 rng(seed);

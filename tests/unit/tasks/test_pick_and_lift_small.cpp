@@ -77,7 +77,7 @@ TEST(PickAndLiftSmall, FiveLookalikesApartOnTheTableAndTheZoneClearOfThem) {
     EXPECT_NEAR(zone.z(), table + 0.3, 1e-6);  // Bullet keeps floats
     for (const char* a : kShapes) {
       const Eigen::Vector3d p = scene.pose(a).translation();
-      EXPECT_NEAR(p.z(), table + sim::kHullMargin + kSize / 2, 1e-6) << a;  // resting on its margin
+      EXPECT_NEAR(p.z(), table + world::kHullMargin + kSize / 2, 1e-6) << a;  // resting on its margin
       EXPECT_GE(p.x(), 0.0);
       EXPECT_LE(p.x(), 0.3);
       EXPECT_LE(std::abs(p.y()), 0.25);
@@ -92,7 +92,7 @@ TEST(PickAndLiftSmall, FiveLookalikesApartOnTheTableAndTheZoneClearOfThem) {
 TEST(PickAndLiftSmall, FootprintsFitOneCoarseVoxelAndAreCentredOnTheirBox) {
   Scene scene(0, 0);
   for (const char* name : kShapes) {
-    const sim::ObjectSpec& spec = scene.world.object_spec(scene.world.object_id(name));
+    const world::ObjectSpec& spec = scene.world.object_spec(scene.world.object_id(name));
     Eigen::AlignedBox3d box;
     for (const auto& p : spec.hull_points) box.extend(p);
     for (const auto& piece : spec.pieces)
@@ -102,7 +102,7 @@ TEST(PickAndLiftSmall, FootprintsFitOneCoarseVoxelAndAreCentredOnTheirBox) {
     EXPECT_LE(extent.head<2>().maxCoeff(), 0.03) << name;
     EXPECT_NEAR(extent.z(), kSize, 1e-12) << name;
     EXPECT_LE(box.center().head<2>().norm(), 0.0036) << name;  // the triangle's centroid is 3.5 mm off its box's
-    EXPECT_EQ(spec.shape == sim::ObjectSpec::Shape::compound, std::string(name) == "star" || std::string(name) == "moon")
+    EXPECT_EQ(spec.shape == world::ObjectSpec::Shape::compound, std::string(name) == "star" || std::string(name) == "moon")
         << name;
   }
 }
@@ -110,7 +110,7 @@ TEST(PickAndLiftSmall, FootprintsFitOneCoarseVoxelAndAreCentredOnTheirBox) {
 // Rays straight down: onto a star's tip they meet its top face; into the notch between two tips
 // (inside the star's outer circle) they pass to the table. Likewise the moon's bite.
 TEST(PickAndLiftSmall, CamerasSeeTheNotchesOfTheCompounds) {
-  sim::World world(test_support::xarm());
+  world::World world(test_support::xarm());
   const double table = world.layout().table_height_m;
   const Eigen::Vector3d star_at(0.1, 0.1, 0), moon_at(0.1, -0.1, 0);
   world.add_object(tasks::standing_prism(world, "star", tasks::star_pieces(5, 0.014, 0.0065), kSize, star_at, 0, {1, 1, 1}));
@@ -133,9 +133,9 @@ TEST(PickAndLiftSmall, CamerasSeeTheNotchesOfTheCompounds) {
 }
 
 TEST(PickAndLiftSmall, CompoundsRestOnTheTableAsBulletCollidesThem) {
-  sim::World world(test_support::xarm());
+  world::World world(test_support::xarm());
   const double table = world.layout().table_height_m;
-  sim::ObjectSpec star = tasks::standing_prism(world, "star", tasks::star_pieces(5, 0.014, 0.0065), kSize, {0.1, 0.1, 0}, 0.3, {1, 1, 1});
+  world::ObjectSpec star = tasks::standing_prism(world, "star", tasks::star_pieces(5, 0.014, 0.0065), kSize, {0.1, 0.1, 0}, 0.3, {1, 1, 1});
   star.mass_kg = 0.03;
   star.pose.translation().z() += 0.05;  // dropped from 5 cm
   world.add_object(star);

@@ -24,7 +24,7 @@ struct Scene : test_support::TaskScene {
       for (int column = 0; column < 8; ++column)
         if ((row + column) % 2 == 0 && k-- == 0)
           return board() * Eigen::Vector3d((column - 3.5) * kSquare, (row - 3.5) * kSquare,
-                                           0.005 + sim::kHullMargin + kCheckerHeight / 2);
+                                           0.005 + world::kHullMargin + kCheckerHeight / 2);
     ADD_FAILURE() << name;
     return {};
   }
@@ -66,8 +66,8 @@ TEST(SetupCheckers, TheOpeningPositionWithTheVariationsCheckersStackedBeside) {
       EXPECT_NEAR((p - scene.pose(off.back()).translation()).head<2>().norm(), 0.0, 1e-6);
       // Stacked hulls rest a margin above what is under them.
       const double level = static_cast<double>(off.size() - i - 1);
-      EXPECT_NEAR(p.z(), scene.world.layout().table_height_m + level * (kCheckerHeight + 2 * sim::kHullMargin) +
-                             sim::kHullMargin + kCheckerHeight / 2, 1e-6);
+      EXPECT_NEAR(p.z(), scene.world.layout().table_height_m + level * (kCheckerHeight + 2 * world::kHullMargin) +
+                             world::kHullMargin + kCheckerHeight / 2, 1e-6);
     }
     for (const auto& name : scene.checkers())
       if (std::find(off.begin(), off.end(), name) == off.end())

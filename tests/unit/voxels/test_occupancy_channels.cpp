@@ -1,17 +1,17 @@
 #include <gtest/gtest.h>
 
-#include "simulator/simulator.hpp"
+#include "sim_step/simulator.hpp"
 #include "voxels/occupancy_channels.hpp"
 
 using namespace qte;
 
 TEST(OccupancyChannels, FreeInViewUnknownUnderTheTable) {
   const robot::RobotModel robot = robot::RobotModel::xarm7();
-  simulator::SimulatorOptions options;
+  sim_step::SimulatorOptions options;
   options.render_threads = 1;
-  simulator::Simulator sim(robot, options);
+  sim_step::Simulator sim(robot, options);
   stream::Record obs("obs");
-  sim.handle(simulator::plan_reset({"reach_target", 0, 1, 2}, 0), [&](const stream::Record& r) { obs = r; });
+  sim.handle(sim_step::plan_reset({"reach_target", 0, 1, 2}, 0), [&](const stream::Record& r) { obs = r; });
   const voxels::ObservedSpace space(obs);
   voxels::GridBounds bounds;  // the scene cube, 16^3
   std::vector<float> channels(16 * 16 * 16 * voxels::kOccupancyChannels);

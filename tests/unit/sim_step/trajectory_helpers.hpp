@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "robot/inverse_kinematics.hpp"
-#include "simulator/simulator.hpp"
+#include "sim_step/simulator.hpp"
 
 namespace qte::test_support {
 
@@ -25,7 +25,7 @@ inline stream::Record straight_trajectory(const robot::RobotModel& robot, const 
 }
 
 // IK for a world-frame TCP pose from the world's current joint positions.
-inline robot::JointVector ik_world(const sim::World& world, const Eigen::Isometry3d& tcp_in_world) {
+inline robot::JointVector ik_world(const world::World& world, const Eigen::Isometry3d& tcp_in_world) {
   const auto q = robot::solve_ik(world.robot(), world.robot_base_pose().inverse() * tcp_in_world,
                                  world.joint_positions());
   EXPECT_TRUE(q.has_value()) << "no IK solution for " << tcp_in_world.translation().transpose();

@@ -1,4 +1,4 @@
-#include "sim/world.hpp"
+#include "world/world.hpp"
 
 #include <btBulletDynamicsCommon.h>
 
@@ -7,7 +7,7 @@
 
 #include "common/error.hpp"
 
-namespace qte::sim {
+namespace qte::world {
 namespace {
 
 btTransform to_bullet(const Eigen::Isometry3d& pose) {
@@ -367,4 +367,4 @@ std::string World::robot_object_contact(double tolerance_m) const {
 
 const btCollisionWorld& World::collision_world() const { return impl_->world; }
 
-}  // namespace qte::sim
+}  // namespace qte::world

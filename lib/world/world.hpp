@@ -10,12 +10,12 @@
 #include <vector>
 
 #include "render/camera.hpp"
-#include "sim/scene_layout.hpp"
+#include "world/scene_layout.hpp"
 #include "robot/robot_model.hpp"
 
 class btCollisionWorld;
 
-namespace qte::sim {
+namespace qte::world {
 
 // Bullet's collision margin around convex hulls (and compounds of them): a hull rests up to
 // this far above what it stands on (cameras see the hull itself). Spawn resting hulls this
@@ -105,4 +105,4 @@ class World {
   void physics_substep();
 };
 
-}  // namespace qte::sim
+}  // namespace qte::world

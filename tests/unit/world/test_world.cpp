@@ -2,32 +2,32 @@
 #include <gtest/gtest.h>
 
 #include "common/error.hpp"
-#include "sim/world.hpp"
+#include "world/world.hpp"
 #include "test_support.hpp"
 
 using namespace qte;
 
 TEST(World, EveryShapeFallsAndRestsOnTheTable) {
-  sim::World world(test_support::xarm());
+  world::World world(test_support::xarm());
   const double table = world.layout().table_height_m;
   // A triangular prism as a convex hull (pick_and_lift_small's shapes are hulls like it).
-  sim::ObjectSpec prism;
+  world::ObjectSpec prism;
   prism.name = "prism";
-  prism.shape = sim::ObjectSpec::Shape::convex_hull;
+  prism.shape = world::ObjectSpec::Shape::convex_hull;
   for (double z : {-0.02, 0.02})
     for (const auto& xy : {Eigen::Vector2d(0.03, 0), Eigen::Vector2d(-0.015, 0.026), Eigen::Vector2d(-0.015, -0.026)})
       prism.hull_points.emplace_back(xy.x(), xy.y(), z);
   prism.pose.translation() << 0.1, 0.1, table + 0.10;
-  sim::ObjectSpec box, cylinder, sphere;
+  world::ObjectSpec box, cylinder, sphere;
   box.name = "box";
   box.size = Eigen::Vector3d(0.04, 0.04, 0.04);
   box.pose.translation() << 0.1, -0.1, table + 0.10;
   cylinder.name = "cylinder";
-  cylinder.shape = sim::ObjectSpec::Shape::cylinder;
+  cylinder.shape = world::ObjectSpec::Shape::cylinder;
   cylinder.size = Eigen::Vector3d(0.02, 0.06, 0);
   cylinder.pose.translation() << 0.2, 0.0, table + 0.10;
   sphere.name = "sphere";
-  sphere.shape = sim::ObjectSpec::Shape::sphere;
+  sphere.shape = world::ObjectSpec::Shape::sphere;
   sphere.size = Eigen::Vector3d(0.02, 0, 0);
   sphere.pose.translation() << 0.25, 0.2, table + 0.10;
   for (const auto* spec : {&prism, &box, &cylinder, &sphere}) world.add_object(*spec);

@@ -1,4 +1,4 @@
-#include "simulator/simulator.hpp"
+#include "sim_step/simulator.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include "common/error.hpp"
 #include "common/random.hpp"
 
-namespace qte::simulator {
+namespace qte::sim_step {
 namespace {
 
 constexpr double kStartTolerance_rad = 1e-3;  // a trajectory must start where the arm is
@@ -43,7 +43,7 @@ SimulatorOptions options_from_camera_arguments(const std::string& cameras, const
 
 std::vector<std::string> camera_names() { return {"front", "wrist", "overhead"}; }
 
-Eigen::Isometry3d camera_pose(const std::string& name, const sim::World& world) {
+Eigen::Isometry3d camera_pose(const std::string& name, const world::World& world) {
   const double table = world.layout().table_height_m;
   if (name == "front")  // across the table, facing the robot, as RLBench's front camera
     return render::look_at({1.05, 0.0, table + 0.85}, {0.0, 0.0, table + 0.05});
@@ -133,7 +133,7 @@ void Simulator::reset(const stream::Record& record,
     record.fail("variation", "0 to " + std::to_string(task_->variation_count() - 1) + " for " +
                                  task_name_ + ", got " + std::to_string(variation_));
   episode_seed_ = record.has("seed") ? record.scalar<int64_t>("seed") : 0;
-  world_ = std::make_unique<sim::World>(robot_);
+  world_ = std::make_unique<world::World>(robot_);
   std::mt19937_64 rng(static_cast<uint64_t>(episode_seed_));
   task_->build(*world_, variation_, rng);
   world_->settle(0.25);  // objects come to rest before the first image
@@ -285,4 +285,4 @@ void run_filter(Simulator& simulator, const std::optional<EpisodePlan>& plan,
   }
 }
 
-}  // namespace qte::simulator
+}  // namespace qte::sim_step

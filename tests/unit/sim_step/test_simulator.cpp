@@ -11,7 +11,7 @@
 #include "test_support.hpp"
 
 using namespace qte;
-using namespace qte::simulator;
+using namespace qte::sim_step;
 
 namespace {
 
@@ -46,7 +46,7 @@ struct SimRun {
 stream::Record run_expert(SimRun& run, const std::string& task, int variation, int64_t seed) {
   run.send(reset_record(task, variation, seed));
   for (const auto& waypoint : run.simulator.task()->expert_waypoints(*run.simulator.world())) {
-    sim::World& world = *run.simulator.world();
+    world::World& world = *run.simulator.world();
     const robot::JointVector q = test_support::ik_world(world, waypoint.tcp_pose);
     run.send(test_support::straight_trajectory(xarm(), world.joint_positions(), q, waypoint.gripper_open));
     if (run.simulator.episode_over()) break;
@@ -96,7 +96,7 @@ TEST(Simulator, UnknownTaskIsAnErrorListingTheTasks) {
 }
 
 TEST(Simulator, BadTrajectoriesFailTheActionWithAReason) {
-  auto failure_of = [](const std::function<stream::Record(const sim::World&)>& make) {
+  auto failure_of = [](const std::function<stream::Record(const world::World&)>& make) {
     SimRun run;
     run.send(reset_record("reach_target", 0, 1));
     run.send(make(*run.simulator.world()));
@@ -106,25 +106,25 @@ TEST(Simulator, BadTrajectoriesFailTheActionWithAReason) {
   };
   const auto& robot = xarm();
   // Not starting at the current joint positions.
-  EXPECT_NE(failure_of([&](const sim::World& w) {
+  EXPECT_NE(failure_of([&](const world::World& w) {
               robot::JointVector elsewhere = w.joint_positions();
               elsewhere[0] += 0.3;
               return test_support::straight_trajectory(robot, elsewhere, elsewhere, true);
             }).find("does not start"), std::string::npos);
   // NaN.
-  EXPECT_NE(failure_of([&](const sim::World& w) {
+  EXPECT_NE(failure_of([&](const world::World& w) {
               robot::JointVector q = w.joint_positions();
               q[2] = NAN;
               return test_support::straight_trajectory(robot, w.joint_positions(), q, true);
             }).find("not_finite"), std::string::npos);
   // Beyond a joint limit (joint 2: -118..120 deg).
-  EXPECT_EQ(failure_of([&](const sim::World& w) {
+  EXPECT_EQ(failure_of([&](const world::World& w) {
               robot::JointVector q = w.joint_positions();
               q[1] = 2.3;
               return test_support::straight_trajectory(robot, w.joint_positions(), q, true);
             }), "joint_limits:joint2");
   // Into the table.
-  EXPECT_NE(failure_of([&](const sim::World& w) {
+  EXPECT_NE(failure_of([&](const world::World& w) {
               robot::JointVector q = w.joint_positions();
               q[1] = 1.6;  // shoulder forward and down: the arm sweeps into the table
               q[3] = 0.2;
@@ -134,7 +134,7 @@ TEST(Simulator, BadTrajectoriesFailTheActionWithAReason) {
   // (it used to run for minutes, and from ~1e8 s overflowed the control-step count).
   for (double end_s : {1e5, 1e9, 1e300}) {
     const auto started = std::chrono::steady_clock::now();
-    EXPECT_EQ(failure_of([&](const sim::World& w) {
+    EXPECT_EQ(failure_of([&](const world::World& w) {
                 stream::Record t = test_support::straight_trajectory(robot, w.joint_positions(), w.joint_positions(), true);
                 t.set<double>("time_s", {2}, std::vector<double>{0, end_s});
                 return t;
@@ -142,7 +142,7 @@ TEST(Simulator, BadTrajectoriesFailTheActionWithAReason) {
     EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count(), 10.0);
   }
   // A planner failure passed on.
-  EXPECT_EQ(failure_of([](const sim::World&) {
+  EXPECT_EQ(failure_of([](const world::World&) {
               stream::Record t("trajectory");
               t.set_string("failure", "ik_failed");
               return t;
@@ -152,7 +152,7 @@ TEST(Simulator, BadTrajectoriesFailTheActionWithAReason) {
 TEST(Simulator, SelfCollisionFailsTheAction) {
   SimRun run;
   run.send(reset_record("reach_target", 0, 1));
-  sim::World& world = *run.simulator.world();
+  world::World& world = *run.simulator.world();
   // Elbow folded far back (joint 4 at 194 deg) with the wrist bent back (joint 6 at 174
   // deg): the wrist comes down onto the forearm.
   robot::JointVector q;
@@ -175,7 +175,7 @@ TEST(Simulator, ProtocolErrorsNameTheRecord) {
 TEST(Simulator, GraspHoldsThroughLiftingAndOpeningReleases) {
   SimRun run;
   run.send(reset_record("pick_and_lift", 0, 3));
-  sim::World& world = *run.simulator.world();
+  world::World& world = *run.simulator.world();
   const auto waypoints = run.simulator.task()->expert_waypoints(world);
   const int block = world.object_id("target");
   const double z0 = world.object_pose(block).translation().z();
@@ -206,7 +206,7 @@ TEST(Simulator, GraspHoldsThroughLiftingAndOpeningReleases) {
 TEST(Simulator, ObjectsArePushedByTheArm) {
   SimRun run;
   run.send(reset_record("pick_and_lift", 0, 3));
-  sim::World& world = *run.simulator.world();
+  world::World& world = *run.simulator.world();
   const int block = world.object_id("distractor1");
   const Eigen::Isometry3d start = world.object_pose(block);
   // Sweep the closed gripper through the block at half its height, along world y.

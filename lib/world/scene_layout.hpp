@@ -4,7 +4,7 @@
 
 #include <Eigen/Geometry>
 
-namespace qte::sim {
+namespace qte::world {
 
 // What the table and the robot base look like; tasks share one layout (DESIGN §4-§5).
 struct SceneLayout {
@@ -21,4 +21,4 @@ struct SceneLayout {
   }
 };
 
-}  // namespace qte::sim
+}  // namespace qte::world

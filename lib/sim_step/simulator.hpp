@@ -13,11 +13,11 @@
 
 #include "render/camera.hpp"
 #include "robot/robot_model.hpp"
-#include "sim/world.hpp"
+#include "world/world.hpp"
 #include "stream/record.hpp"
 #include "tasks/task.hpp"
 
-namespace qte::simulator {
+namespace qte::sim_step {
 
 struct CameraSpec {
   std::string name;              // "front", "wrist", "overhead"
@@ -41,7 +41,7 @@ struct SimulatorOptions {
 SimulatorOptions options_from_camera_arguments(const std::string& cameras, const std::string& image_size);
 
 // The camera poses of the scene layout (front: facing the robot across the table).
-Eigen::Isometry3d camera_pose(const std::string& name, const sim::World& world);
+Eigen::Isometry3d camera_pose(const std::string& name, const world::World& world);
 std::vector<std::string> camera_names();
 
 class Simulator {
@@ -57,7 +57,7 @@ class Simulator {
   bool episode_over() const { return terminal_; }
 
   // For tests and tools that drive the world directly.
-  sim::World* world() { return world_.get(); }
+  world::World* world() { return world_.get(); }
   const tasks::Task* task() const { return task_.get(); }
 
  private:
@@ -68,7 +68,7 @@ class Simulator {
 
   const robot::RobotModel& robot_;
   SimulatorOptions options_;
-  std::unique_ptr<sim::World> world_;
+  std::unique_ptr<world::World> world_;
   std::unique_ptr<tasks::Task> task_;
   std::string task_name_;
   int variation_ = 0;
@@ -113,4 +113,4 @@ void run_filter(Simulator& simulator, const std::optional<EpisodePlan>& plan,
                 const std::function<std::optional<stream::Record>()>& next_input,
                 const std::function<void(const stream::Record&)>& emit);
 
-}  // namespace qte::simulator
+}  // namespace qte::sim_step
