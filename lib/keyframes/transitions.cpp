@@ -5,6 +5,7 @@
 
 #include "common/random.hpp"
 #include "keyframes/keyframes.hpp"
+#include "tasks/episode.hpp"
 #include "voxels/grid_fields.hpp"
 
 namespace qte::keyframes {
@@ -174,21 +175,21 @@ void EpisodeConverter::finish() {
   episode_.clear();
 }
 
-void EpisodeConverter::convert(std::vector<stream::Record>& episode, const stream::Record* summary) {
-  counts_.episodes += 1;
+std::vector<int> EpisodeConverter::usable_keyframes(const std::vector<stream::Record>& episode,
+                                                    const stream::Record* summary, bool& success) {
   if (episode.size() < 2) {
     counts_.skipped_empty += 1;
-    return;
+    return {};
   }
   for (std::size_t i = 1; i < episode.size(); ++i)
     if (episode[i].scalar<int32_t>("frame") != episode[i - 1].scalar<int32_t>("frame") + 1) {
       counts_.skipped_out_of_order += 1;
-      return;
+      return {};
     }
-  const bool success = summary ? summary->scalar<uint8_t>("success") != 0 : episode.back().scalar<uint8_t>("success") != 0;
+  success = summary ? summary->scalar<uint8_t>("success") != 0 : episode.back().scalar<uint8_t>("success") != 0;
   if (!success && !options_.keep_failed) {
     counts_.skipped_failed += 1;
-    return;
+    return {};
   }
   std::vector<FrameState> states;
   for (const auto& obs : episode) {
@@ -202,19 +203,26 @@ void EpisodeConverter::convert(std::vector<stream::Record>& episode, const strea
   const std::vector<int> keyframes = discover_keyframes(states, options_.stopping_delta);
   if (keyframes.empty()) {
     counts_.skipped_no_keyframes += 1;
-    return;
+    return {};
   }
   const voxels::GridBounds& scene = options_.hierarchy.scene;
   for (int k : keyframes)
     if (!scene.contains(scene.index_of(gripper_pose(episode[k]).translation()))) {
       counts_.skipped_outside_bounds += 1;
-      return;
+      return {};
     }
+  return keyframes;
+}
 
+void EpisodeConverter::convert(std::vector<stream::Record>& episode, const stream::Record* summary) {
+  counts_.episodes += 1;
+  bool success = false;
+  const std::vector<int> keyframes = usable_keyframes(episode, summary, success);
+  if (keyframes.empty()) return;
   const int64_t episode_key = episode_key_of(episode, options_.seed);
 
   // Chains: from frame 0 and every n-th frame before the last keyframe, through the
-  // keyframes after it.
+  // keyframes after it. Each frame is stored once, before the first transition that uses it.
   std::vector<int> starts = {0};
   if (options_.augmentation_every_n > 0)
     for (int i = options_.augmentation_every_n; i < keyframes.back(); i += options_.augmentation_every_n) starts.push_back(i);
@@ -225,47 +233,11 @@ void EpisodeConverter::convert(std::vector<stream::Record>& episode, const strea
       counts_.frames += 1;
     }
   };
-  const voxels::CoarseToFine& h = options_.hierarchy;
-  std::uniform_real_distribution<double> shift(-options_.crop_shift_fraction, options_.crop_shift_fraction);
   for (int start : starts) {
     int previous = start, step = 0;
     for (int k : keyframes) {
       if (k <= start) continue;
-      const stream::Record& target = episode[k];
-      const Eigen::Isometry3d pose = gripper_pose(target);
-      std::vector<Eigen::Vector3d> shifts(h.depths, Eigen::Vector3d::Zero());
-      if (options_.crop_augmentation)
-        for (int d = 1; d < h.depths; ++d)  // a fraction of depth d's own half edge
-          shifts[d] = Eigen::Vector3d(shift(rng_), shift(rng_), shift(rng_)) * h.offset_at(d);
-      const auto indices = h.indices_of(pose.translation(), shifts);
-
-      stream::Record t("transition");
-      t.set_scalar<int64_t>("episode_key", episode_key);
-      t.set_scalar<int32_t>("frame", episode[previous].scalar<int32_t>("frame"));
-      t.set_scalar<int32_t>("next_frame", target.scalar<int32_t>("frame"));
-      t.set_scalar<int32_t>("step", step);
-      t.set_scalar<int32_t>("voxels", h.voxels());
-      Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-      for (int d = 0; d < h.depths; ++d) {
-        if (d > 0) centre += shifts[d];
-        const voxels::GridBounds b = h.bounds_at(d, centre);
-        const std::string prefix = "depth" + std::to_string(d);
-        t.set<int32_t>(prefix + ".index", {3}, indices[d].data());
-        t.set<double>(prefix + ".bounds", {4}, voxels::bounds_values(b));
-        centre = b.centre_of(indices[d]);
-      }
-      const Eigen::Vector3i bins = rotation_bins(pose.linear());
-      t.set<int32_t>("rotation_bins", {3}, bins.data());
-      t.set_scalar<uint8_t>("gripper_open", target.scalar<uint8_t>("gripper_open"));
-      t.set_scalar<uint8_t>("ignore_collisions",
-                            target.has("ignore_collisions") ? target.scalar<uint8_t>("ignore_collisions") : 0);
-      const Eigen::Quaterniond q(pose.linear());
-      t.set<double>("target_pose", {7}, std::vector<double>{pose.translation().x(), pose.translation().y(),
-                                                            pose.translation().z(), q.x(), q.y(), q.z(), q.w()});
-      const bool last = k == keyframes.back();
-      t.set_scalar<float>("reward", last && success ? 100.0f : 0.0f);
-      t.set_scalar<uint8_t>("terminal", last);
-      t.set_scalar<uint8_t>("demo", options_.demo);
+      const stream::Record t = transition(episode, previous, k, step, episode_key, k == keyframes.back(), success);
       store(previous);
       store(k);
       emit_(t);
@@ -275,6 +247,50 @@ void EpisodeConverter::convert(std::vector<stream::Record>& episode, const strea
     }
   }
   counts_.converted += 1;
+}
+
+// The transition from frame `from` to keyframe `to`: the target's voxel at every depth (the
+// deeper grids' centres shifted at random with crop augmentation), rotation bins, gripper; the
+// success reward on the last keyframe of a successful episode.
+stream::Record EpisodeConverter::transition(const std::vector<stream::Record>& episode, int from, int to, int step,
+                                            int64_t episode_key, bool last, bool success) {
+  const voxels::CoarseToFine& h = options_.hierarchy;
+  const stream::Record& target = episode[to];
+  const Eigen::Isometry3d pose = gripper_pose(target);
+  std::uniform_real_distribution<double> shift(-options_.crop_shift_fraction, options_.crop_shift_fraction);
+  std::vector<Eigen::Vector3d> shifts(h.depths, Eigen::Vector3d::Zero());
+  if (options_.crop_augmentation)
+    for (int d = 1; d < h.depths; ++d)  // a fraction of depth d's own half edge
+      shifts[d] = Eigen::Vector3d(shift(rng_), shift(rng_), shift(rng_)) * h.offset_at(d);
+  const auto indices = h.indices_of(pose.translation(), shifts);
+
+  stream::Record t("transition");
+  t.set_scalar<int64_t>("episode_key", episode_key);
+  t.set_scalar<int32_t>("frame", episode[from].scalar<int32_t>("frame"));
+  t.set_scalar<int32_t>("next_frame", target.scalar<int32_t>("frame"));
+  t.set_scalar<int32_t>("step", step);
+  t.set_scalar<int32_t>("voxels", h.voxels());
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (int d = 0; d < h.depths; ++d) {
+    if (d > 0) centre += shifts[d];
+    const voxels::GridBounds b = h.bounds_at(d, centre);
+    const std::string prefix = "depth" + std::to_string(d);
+    t.set<int32_t>(prefix + ".index", {3}, indices[d].data());
+    t.set<double>(prefix + ".bounds", {4}, voxels::bounds_values(b));
+    centre = b.centre_of(indices[d]);
+  }
+  const Eigen::Vector3i bins = rotation_bins(pose.linear());
+  t.set<int32_t>("rotation_bins", {3}, bins.data());
+  t.set_scalar<uint8_t>("gripper_open", target.scalar<uint8_t>("gripper_open"));
+  t.set_scalar<uint8_t>("ignore_collisions",
+                        target.has("ignore_collisions") ? target.scalar<uint8_t>("ignore_collisions") : 0);
+  const Eigen::Quaterniond q(pose.linear());
+  t.set<double>("target_pose", {7}, std::vector<double>{pose.translation().x(), pose.translation().y(),
+                                                        pose.translation().z(), q.x(), q.y(), q.z(), q.w()});
+  t.set_scalar<float>("reward", last && success ? tasks::kSuccessReward : 0.0f);
+  t.set_scalar<uint8_t>("terminal", last);
+  t.set_scalar<uint8_t>("demo", options_.demo);
+  return t;
 }
 
 }  // namespace qte::keyframes

@@ -47,7 +47,13 @@ class EpisodeConverter {
   const ConversionCounts& counts() const { return counts_; }
 
  private:
+  // The steps of converting one episode: its keyframes and success (no keyframes when the
+  // episode is skipped, the reason counted), then each transition of its chains.
+  std::vector<int> usable_keyframes(const std::vector<stream::Record>& episode, const stream::Record* summary,
+                                    bool& success);
   void convert(std::vector<stream::Record>& episode, const stream::Record* summary);
+  stream::Record transition(const std::vector<stream::Record>& episode, int from, int to, int step, int64_t episode_key,
+                            bool last, bool success);
 
   TransitionOptions options_;
   std::function<void(const stream::Record&)> emit_;
