@@ -54,7 +54,6 @@ std::vector<int> branches(const float* q, int count, const Branching& branching)
 
 namespace {
 
-
 int argmax(const float* q, int count) { return top_k(q, count, 1)[0]; }
 
 }  // namespace
@@ -78,118 +77,162 @@ std::vector<Choice> expand_batch(const DepthEvaluator& evaluate, const voxels::C
   return expand_batch(evaluate, nullptr, hierarchy, clouds, proprios, branching);
 }
 
+namespace {
+
+// The trees of a batch, level by level: every node's grid, its observation, its parent and the
+// voxel of the parent it expands. Children are appended in their parents' order, so each
+// level's nodes are grouped by observation. Per depth, the ranking networks' outputs and the
+// valuing networks' (none when one set of networks both ranks and values).
+struct Node {
+  voxels::GridBounds bounds;
+  int observation = 0;
+  int parent = -1;
+  int parent_voxel = -1;
+};
+struct Trees {
+  std::vector<std::vector<Node>> levels;
+  std::vector<nets::QValues> ranked, valued;
+  bool separate_values = false;
+  int expanded_grids = 0;
+  const std::vector<nets::QValues>& values() const { return separate_values ? valued : ranked; }
+};
+
+// One level's grids through the networks: voxelized with one pass over each observation's
+// points for all its grids, then one forward of each set of networks.
+void evaluate_level(const DepthEvaluator& rank, const DepthEvaluator& value_of, int d, int cells,
+                    const std::vector<voxels::PointCloud>& clouds, const std::vector<std::vector<float>>& proprios,
+                    Trees& trees) {
+  const std::vector<Node>& level = trees.levels[d];
+  const int n = static_cast<int>(level.size());
+  const std::size_t grid_floats = static_cast<std::size_t>(cells) * voxels::kChannels;
+  std::vector<float> batch(grid_floats * n);
+  std::vector<float> proprio_batch;
+  for (int first = 0; first < n;) {
+    int last = first;
+    std::vector<voxels::GridBounds> grids;
+    while (last < n && level[last].observation == level[first].observation) grids.push_back(level[last++].bounds);
+    voxels::voxelize_many(clouds[level[first].observation], grids, batch.data() + first * grid_floats);
+    first = last;
+  }
+  for (const Node& node : level)
+    proprio_batch.insert(proprio_batch.end(), proprios[node.observation].begin(), proprios[node.observation].end());
+  trees.ranked[d] = rank(d, batch.data(), proprio_batch.data(), n);
+  if (value_of) trees.valued[d] = value_of(d, batch.data(), proprio_batch.data(), n);
+  for (const nets::QValues* q : {&trees.ranked[d], value_of ? &trees.valued[d] : nullptr}) {
+    if (!q) continue;
+    if (static_cast<int>(q->translation.size()) != n * cells)
+      throw Error("tree expansion: depth " + std::to_string(d) + " returned the wrong number of Q values");
+    check_finite(*q, d);
+  }
+  trees.expanded_grids += n;
+}
+
+// Grows the trees depth by depth: each level evaluated, each node's branches the next level.
+Trees grow(const DepthEvaluator& rank, const DepthEvaluator& value_of, const voxels::CoarseToFine& hierarchy,
+           const std::vector<voxels::PointCloud>& clouds, const std::vector<std::vector<float>>& proprios,
+           const Branching& branching) {
+  const int depths = hierarchy.depths, v = hierarchy.voxels(), cells = v * v * v;
+  Trees trees;
+  trees.levels.resize(depths);
+  trees.ranked.resize(depths);
+  trees.valued.resize(depths);
+  trees.separate_values = static_cast<bool>(value_of);
+  for (std::size_t i = 0; i < clouds.size(); ++i) trees.levels[0].push_back({hierarchy.scene, static_cast<int>(i), -1, -1});
+  for (int d = 0; d < depths; ++d) {
+    evaluate_level(rank, value_of, d, cells, clouds, proprios, trees);
+    if (d + 1 == depths) break;
+    const std::vector<Node>& level = trees.levels[d];
+    for (std::size_t i = 0; i < level.size(); ++i)
+      for (int flat : branches(trees.ranked[d].translation.data() + i * cells, cells, branching))
+        trees.levels[d + 1].push_back({hierarchy.bounds_at(d + 1, level[i].bounds.centre_of(voxels::index_from_flat(flat, v))),
+                                       level[i].observation, static_cast<int>(i), flat});
+  }
+  return trees;
+}
+
+// Values bottom-up: a leaf is worth the value of its best-ranked voxel (its max Q when one set
+// of networks ranks and values); a node's value through child c is (q of c's voxel + c's
+// value) / 2, and the node is worth its best child.
+struct Backup {
+  std::vector<std::vector<float>> value;
+  std::vector<std::vector<int>> best_child;
+};
+
+Backup back_up(const Trees& trees, int cells) {
+  const int depths = static_cast<int>(trees.levels.size()), leaf = depths - 1;
+  const std::vector<nets::QValues>& outputs = trees.values();
+  Backup b{std::vector<std::vector<float>>(depths), std::vector<std::vector<int>>(depths)};
+  for (std::size_t i = 0; i < trees.levels[leaf].size(); ++i) {
+    const float* q = trees.ranked[leaf].translation.data() + i * cells;
+    b.value[leaf].push_back(outputs[leaf].translation[i * cells + argmax(q, cells)]);
+  }
+  for (int d = leaf - 1; d >= 0; --d) {
+    b.value[d].assign(trees.levels[d].size(), -1e30f);
+    b.best_child[d].assign(trees.levels[d].size(), -1);
+    for (std::size_t c = 0; c < trees.levels[d + 1].size(); ++c) {
+      const Node& child = trees.levels[d + 1][c];
+      const float q = outputs[d].translation[static_cast<std::size_t>(child.parent) * cells + child.parent_voxel];
+      const float through = branch_value(q, b.value[d + 1][c]);
+      if (through > b.value[d][child.parent]) {  // strict: the earlier (higher-ranked) child wins ties
+        b.value[d][child.parent] = through;
+        b.best_child[d][child.parent] = static_cast<int>(c);
+      }
+    }
+  }
+  return b;
+}
+
+// Each tree's best path from its root: per depth the voxel, its grid and Q; at the leaf the
+// ranking networks' rotation bins and gripper action; the nodes each depth below the root had.
+std::vector<Choice> best_paths(const Trees& trees, const Backup& backup, int voxels_per_side, std::size_t roots) {
+  const int depths = static_cast<int>(trees.levels.size()), leaf = depths - 1;
+  const int cells = voxels_per_side * voxels_per_side * voxels_per_side;
+  const std::vector<nets::QValues>& outputs = trees.values();
+  std::vector<Choice> choices(roots);
+  for (int d = 1; d < depths; ++d) {
+    for (Choice& c : choices) c.branches.push_back(0);
+    for (const Node& node : trees.levels[d]) choices[node.observation].branches.back() += 1;
+  }
+  for (std::size_t root = 0; root < roots; ++root) {
+    Choice& choice = choices[root];
+    choice.expanded_grids = trees.expanded_grids;
+    int node = static_cast<int>(root);
+    choice.value = backup.value[0][node];
+    for (int d = 0; d < depths; ++d) {
+      const std::size_t at = static_cast<std::size_t>(node) * cells;
+      const int voxel = d + 1 < depths ? trees.levels[d + 1][backup.best_child[d][node]].parent_voxel
+                                       : argmax(trees.ranked[d].translation.data() + at, cells);
+      choice.indices.push_back(voxels::index_from_flat(voxel, voxels_per_side));
+      choice.bounds.push_back(trees.levels[d][node].bounds);
+      choice.q_values.push_back(outputs[d].translation[at + voxel]);
+      if (d + 1 < depths) node = backup.best_child[d][node];
+    }
+    if (trees.ranked[leaf].rotation.empty()) continue;
+    const std::size_t r = static_cast<std::size_t>(node) * nets::kRotationAxes * nets::kRotationBins;
+    for (int axis = 0; axis < nets::kRotationAxes; ++axis) {
+      const std::size_t at = r + axis * nets::kRotationBins;
+      choice.rotation_bins[axis] = argmax(trees.ranked[leaf].rotation.data() + at, nets::kRotationBins);
+      choice.rotation_q[axis] = outputs[leaf].rotation[at + choice.rotation_bins[axis]];
+    }
+    const std::size_t g = static_cast<std::size_t>(node) * nets::kGripperActions;
+    const int open = argmax(trees.ranked[leaf].gripper.data() + g, nets::kGripperActions);
+    choice.gripper_open = open == 1;  // index 1 = open, as the transitions' gripper_open
+    choice.gripper_q = outputs[leaf].gripper[g + open];
+  }
+  return choices;
+}
+
+}  // namespace
+
 std::vector<Choice> expand_batch(const DepthEvaluator& rank, const DepthEvaluator& value_of,
                                  const voxels::CoarseToFine& hierarchy, const std::vector<voxels::PointCloud>& clouds,
                                  const std::vector<std::vector<float>>& proprios, const Branching& branching) {
   if (branching.k < 1) throw Error("tree expansion needs k >= 1");
   if (clouds.size() != proprios.size() || clouds.empty())
     throw Error("tree expansion needs one proprio vector per point cloud");
-  const int depths = hierarchy.depths, v = hierarchy.voxels(), cells = v * v * v;
-  const std::size_t grid_floats = static_cast<std::size_t>(cells) * voxels::kChannels;
-
-  // Level by level, every node of the trees: its grid, its observation, its parent and the
-  // voxel of the parent it expands, and (filled after the forward) its Q volume. Children are
-  // appended in their parents' order, so each level's nodes are grouped by observation.
-  struct Node {
-    voxels::GridBounds bounds;
-    int observation = 0;
-    int parent = -1;
-    int parent_voxel = -1;
-  };
-  std::vector<std::vector<Node>> levels(depths);
-  // Per depth, the ranking networks' outputs and the valuing networks' (the same when one set
-  // of networks both ranks and values).
-  std::vector<nets::QValues> ranked(depths), valued(depths);
-  for (std::size_t i = 0; i < clouds.size(); ++i) levels[0].push_back({hierarchy.scene, static_cast<int>(i), -1, -1});
-  int expanded_grids = 0;
-  for (int d = 0; d < depths; ++d) {
-    const std::vector<Node>& level = levels[d];
-    const int n = static_cast<int>(level.size());
-    std::vector<float> batch(grid_floats * n);
-    std::vector<float> proprio_batch;
-    for (int first = 0; first < n;) {  // one pass over each observation's points for all its grids
-      int last = first;
-      std::vector<voxels::GridBounds> grids;
-      while (last < n && level[last].observation == level[first].observation) grids.push_back(level[last++].bounds);
-      voxels::voxelize_many(clouds[level[first].observation], grids, batch.data() + first * grid_floats);
-      first = last;
-    }
-    for (const Node& node : level)
-      proprio_batch.insert(proprio_batch.end(), proprios[node.observation].begin(), proprios[node.observation].end());
-    ranked[d] = rank(d, batch.data(), proprio_batch.data(), n);
-    if (value_of) valued[d] = value_of(d, batch.data(), proprio_batch.data(), n);
-    for (const nets::QValues* q : {&ranked[d], value_of ? &valued[d] : nullptr}) {
-      if (!q) continue;
-      if (static_cast<int>(q->translation.size()) != n * cells)
-        throw Error("tree expansion: depth " + std::to_string(d) + " returned the wrong number of Q values");
-      check_finite(*q, d);
-    }
-    expanded_grids += n;
-    if (d + 1 == depths) break;
-    for (int i = 0; i < n; ++i)
-      for (int flat : branches(ranked[d].translation.data() + static_cast<std::size_t>(i) * cells, cells, branching))
-        levels[d + 1].push_back({hierarchy.bounds_at(d + 1, level[i].bounds.centre_of(voxels::index_from_flat(flat, v))),
-                                 level[i].observation, i, flat});
-  }
-
-  const std::vector<nets::QValues>& outputs = value_of ? valued : ranked;
-  // Values bottom-up: a leaf is worth the value of its best-ranked voxel (its max Q when one
-  // set of networks ranks and values); a node's value through child c is (q of c's voxel +
-  // c's value) / 2, and the node is worth its best child.
-  std::vector<std::vector<float>> value(depths);
-  std::vector<std::vector<int>> best_child(depths);
-  const int leaf = depths - 1;
-  for (std::size_t i = 0; i < levels[leaf].size(); ++i) {
-    const float* q = ranked[leaf].translation.data() + i * cells;
-    value[leaf].push_back(outputs[leaf].translation[i * cells + argmax(q, cells)]);
-  }
-  for (int d = leaf - 1; d >= 0; --d) {
-    value[d].assign(levels[d].size(), -1e30f);
-    best_child[d].assign(levels[d].size(), -1);
-    for (std::size_t c = 0; c < levels[d + 1].size(); ++c) {
-      const Node& child = levels[d + 1][c];
-      const float q = outputs[d].translation[static_cast<std::size_t>(child.parent) * cells + child.parent_voxel];
-      const float through = branch_value(q, value[d + 1][c]);
-      if (through > value[d][child.parent]) {  // strict: the earlier (higher-ranked) child wins ties
-        value[d][child.parent] = through;
-        best_child[d][child.parent] = static_cast<int>(c);
-      }
-    }
-  }
-  // Follow each tree's best path from its root; count its nodes per depth below the root.
-  std::vector<Choice> choices(clouds.size());
-  for (int d = 1; d < depths; ++d) {
-    for (Choice& c : choices) c.branches.push_back(0);
-    for (const Node& node : levels[d]) choices[node.observation].branches.back() += 1;
-  }
-  for (std::size_t root = 0; root < clouds.size(); ++root) {
-    Choice& choice = choices[root];
-    choice.expanded_grids = expanded_grids;
-    int node = static_cast<int>(root);
-    choice.value = value[0][node];
-    for (int d = 0; d < depths; ++d) {
-      const std::size_t at = static_cast<std::size_t>(node) * cells;
-      const int voxel = d + 1 < depths ? levels[d + 1][best_child[d][node]].parent_voxel
-                                       : argmax(ranked[d].translation.data() + at, cells);
-      choice.indices.push_back(voxels::index_from_flat(voxel, v));
-      choice.bounds.push_back(levels[d][node].bounds);
-      choice.q_values.push_back(outputs[d].translation[at + voxel]);
-      if (d + 1 < depths) node = best_child[d][node];
-    }
-    if (!ranked[leaf].rotation.empty()) {
-      const std::size_t r = static_cast<std::size_t>(node) * nets::kRotationAxes * nets::kRotationBins;
-      for (int axis = 0; axis < nets::kRotationAxes; ++axis) {
-        const std::size_t at = r + axis * nets::kRotationBins;
-        choice.rotation_bins[axis] = argmax(ranked[leaf].rotation.data() + at, nets::kRotationBins);
-        choice.rotation_q[axis] = outputs[leaf].rotation[at + choice.rotation_bins[axis]];
-      }
-      const std::size_t g = static_cast<std::size_t>(node) * nets::kGripperActions;
-      const int open = argmax(ranked[leaf].gripper.data() + g, nets::kGripperActions);
-      choice.gripper_open = open == 1;  // index 1 = open, as the transitions' gripper_open
-      choice.gripper_q = outputs[leaf].gripper[g + open];
-    }
-  }
-  return choices;
+  const int v = hierarchy.voxels();
+  const Trees trees = grow(rank, value_of, hierarchy, clouds, proprios, branching);
+  return best_paths(trees, back_up(trees, v * v * v), v, clouds.size());
 }
 
 DepthEvaluator network_evaluator(const std::vector<nets::QAttentionNet>& nets) {
