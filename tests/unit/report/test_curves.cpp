@@ -24,6 +24,21 @@ const char* kRuns =
     "qte,1,1000,0.8,0.7,0.9\n"
     "qte,2,1000,1.0,0.9,1.0\n";
 
+// The curves of kRuns with interval bands, and a 400x300 picture's options.
+std::vector<Curve> run_curves() {
+  CurveBuilder builder({"step", "success_rate", "label"}, Band::ci);
+  builder.add(parse_csv("runs.csv", kRuns));
+  return builder.curves();
+}
+
+CurvePlotOptions small_picture(const std::string& title) {
+  CurvePlotOptions options;
+  options.width_px = 400;
+  options.height_px = 300;
+  options.title = title;
+  return options;
+}
+
 }  // namespace
 
 TEST(CurveBuilder, GroupsInOrderOfAppearanceWithMeanAndStdOverSeeds) {
@@ -106,17 +121,12 @@ TEST(CurveBuilder, ErrorsNameTheTableLineAndColumn) {
 }
 
 TEST(CurvePlot, PngOfTheAskedSizeAndTheSameBytesEveryTime) {
-  CurveBuilder builder({"step", "success_rate", "label"}, Band::ci);
-  builder.add(parse_csv("runs.csv", kRuns));
-  CurvePlotOptions options;
-  options.width_px = 400;
-  options.height_px = 300;
-  options.title = "reach_target";
+  CurvePlotOptions options = small_picture("reach_target");
   options.x_label = "step";
   options.y_label = "success_rate";
   options.legend = true;
   options.fixed_y = true;
-  const std::vector<uint8_t> png = curve_plot_png(builder.curves(), options);
+  const std::vector<uint8_t> png = curve_plot_png(run_curves(), options);
   ASSERT_GT(png.size(), 24u);
   EXPECT_EQ(std::string(png.begin() + 1, png.begin() + 4), "PNG");
   auto big_endian = [&](std::size_t at) {
@@ -124,7 +134,7 @@ TEST(CurvePlot, PngOfTheAskedSizeAndTheSameBytesEveryTime) {
   };
   EXPECT_EQ(big_endian(16), 400u);  // IHDR width, height
   EXPECT_EQ(big_endian(20), 300u);
-  EXPECT_EQ(curve_plot_png(builder.curves(), options), png);
+  EXPECT_EQ(curve_plot_png(run_curves(), options), png);
 }
 
 // Values at the ends of the double range: an error, not a plot whose ticks never end.
@@ -146,13 +156,8 @@ TEST(CurvePlot, ARangeBeyondWhatADoubleHoldsIsAnError) {
 
 // A title wider than the picture is drawn smaller: its ink stays inside the picture's margins.
 TEST(CurvePlot, ALongTitleIsShrunkNotCutOff) {
-  CurveBuilder builder({"step", "success_rate", "label"}, Band::ci);
-  builder.add(parse_csv("runs.csv", kRuns));
-  CurvePlotOptions options;
-  options.width_px = 400;
-  options.height_px = 300;
-  options.title = "lift_numbered_block: qte-k10-t10 against c2farm-k1-t0, mean and std over seeds 0, 1 and 2";
-  const std::vector<uint8_t> png = curve_plot_png(builder.curves(), options);
+  const std::vector<uint8_t> png = curve_plot_png(
+      run_curves(), small_picture("lift_numbered_block: qte-k10-t10 against c2farm-k1-t0, mean and std over seeds 0, 1 and 2"));
   const cv::Mat image = cv::imdecode(png, cv::IMREAD_GRAYSCALE);
   ASSERT_EQ(image.cols, 400);
   int left = image.cols, right = -1;
