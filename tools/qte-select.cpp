@@ -122,22 +122,21 @@ double non_negative(const cli::Arguments& args, const std::string& name) {
 
 }  // namespace
 
-static void run(const cli::Arguments& args) {
-  const std::string checkpoint = args.text("checkpoint");
-  if (checkpoint.empty()) throw UsageError("--checkpoint FILE is required");
-  const qattention::Branching branching = qattention::parse_branching(args, "k", 1);
-  const int64_t threads = args.integer("threads", 1, 256);
-  if (threads < 1) throw UsageError("--threads must be at least 1");
+namespace {
+
+qattention::Exploration exploration_from(const cli::Arguments& args) {
   qattention::Exploration exploration;
   exploration.epsilon = probability(args, "epsilon");
   exploration.index_noise = non_negative(args, "index-noise");
   exploration.rotation_noise = non_negative(args, "rotation-noise");
   exploration.gripper_flip = probability(args, "gripper-flip");
-  const bool ignore_collisions = args.flag("ignore-collisions"), reload = args.flag("reload");
-  const std::string png_dir = args.text("png");
+  return exploration;
+}
 
-  nets::set_torch_threads(static_cast<int>(threads));
-  qattention::CheckpointNetworks networks(checkpoint);
+// The hierarchy the networks were trained on; --voxels, --depths, --bounds and --offset that
+// differ from it are refused (they fill it in for checkpoints written before it was kept).
+voxels::CoarseToFine checkpoint_hierarchy(const cli::Arguments& args, const qattention::CheckpointNetworks& networks,
+                                          const std::string& checkpoint) {
   const auto agree = [&](const char* option, int checkpoint_value) {
     if (args.has(option) && args.integer(option) != checkpoint_value)
       throw UsageError(std::string("--") + option + " " + args.text(option) + " differs from the checkpoint's " +
@@ -145,7 +144,6 @@ static void run(const cli::Arguments& args) {
   };
   agree("voxels", networks.config().net.voxels);
   agree("depths", networks.config().depths);
-  // The hierarchy the networks were trained on; options that differ from it are refused.
   voxels::CoarseToFine hierarchy = networks.hierarchy().value_or(voxels::CoarseToFine{});
   hierarchy.depths = networks.config().depths;
   hierarchy.scene.voxels = networks.config().net.voxels;
@@ -170,6 +168,41 @@ static void run(const cli::Arguments& args) {
   } catch (const Error& e) {
     throw UsageError(e.what());
   }
+  return hierarchy;
+}
+
+// One observation's action; an error of the networks (a diverged checkpoint) names the record.
+// The action's pictures read `observed` later: it must outlive the action.
+qattention::Action act_on(const stream::Record& obs, const voxels::ObservationCloud& observed, int32_t step,
+                          const qattention::DepthEvaluator& evaluate, const voxels::CoarseToFine& hierarchy,
+                          const qattention::Branching& branching, const qattention::Exploration& exploration,
+                          std::mt19937_64& rng, const std::string& checkpoint) {
+  const std::vector<float> proprio = qattention::proprio_of(obs, step);
+  for (float p : proprio)
+    if (!std::isfinite(p)) obs.fail("gripper_opening_m", "a finite gripper opening");
+  try {
+    return qattention::act(evaluate, hierarchy, observed.view(), proprio, branching, exploration, rng);
+  } catch (const StreamError&) {
+    throw;
+  } catch (const Error& e) {
+    throw StreamError(obs.position, std::string(e.what()) + " (checkpoint " + checkpoint + ")");
+  }
+}
+
+}  // namespace
+
+static void run(const cli::Arguments& args) {
+  const std::string checkpoint = args.text("checkpoint");
+  if (checkpoint.empty()) throw UsageError("--checkpoint FILE is required");
+  const qattention::Branching branching = qattention::parse_branching(args, "k", 1);
+  const int64_t threads = args.integer("threads", 1, 256);
+  const qattention::Exploration exploration = exploration_from(args);
+  const bool ignore_collisions = args.flag("ignore-collisions"), reload = args.flag("reload");
+  const std::string png_dir = args.text("png");
+
+  nets::set_torch_threads(static_cast<int>(threads));
+  qattention::CheckpointNetworks networks(checkpoint);
+  const voxels::CoarseToFine hierarchy = checkpoint_hierarchy(args, networks, checkpoint);
   if (!png_dir.empty() && ::mkdir(png_dir.c_str(), 0755) != 0 && errno != EEXIST)
     throw_system_error("cannot create directory " + png_dir);
 
@@ -181,25 +214,14 @@ static void run(const cli::Arguments& args) {
     writer.write(*record);
     if (record->type() != "obs") continue;
     if (record->has("terminal") && record->scalar<uint8_t>("terminal") != 0) continue;
-    const voxels::ObservationCloud observed = voxels::observation_cloud(*record);
     const int32_t step = record->scalar<int32_t>("step");
     if (reload && step == 0 && networks.reload_if_changed())
       std::cerr << "qte-select: loaded checkpoint " << checkpoint << " at training step " << networks.step()
                 << std::endl;
-    const std::vector<float> proprio = qattention::proprio_of(*record, step);
-    for (float p : proprio)
-      if (!std::isfinite(p)) record->fail("gripper_opening_m", "a finite gripper opening");
     std::mt19937_64 rng(derive_seed(args.seed(), actions));
-    std::optional<qattention::Action> chosen;
-    try {
-      chosen.emplace(
-          qattention::act(evaluate, hierarchy, observed.view(), proprio, branching, exploration, rng));
-    } catch (const StreamError&) {
-      throw;
-    } catch (const Error& e) {  // a diverged checkpoint: name the observation it failed on
-      throw StreamError(record->position, std::string(e.what()) + " (checkpoint " + checkpoint + ")");
-    }
-    qattention::Action& action = *chosen;
+    const voxels::ObservationCloud observed = voxels::observation_cloud(*record);
+    qattention::Action action =  // not const: its pictures compute the grids they show lazily
+        act_on(*record, observed, step, evaluate, hierarchy, branching, exploration, rng, checkpoint);
     if (!png_dir.empty()) qattention::save_q_pictures(png_dir, actions, action);
     writer.write(qattention::action_record(action.choice, ignore_collisions, branching.k, action.explored,
                                            networks.step(), step));
