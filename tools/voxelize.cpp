@@ -8,10 +8,8 @@
 #include "cli/command.hpp"
 #include "stream/reader.hpp"
 #include "stream/writer.hpp"
-#include "voxels/grid_fields.hpp"
-#include "voxels/observation_cloud.hpp"
-#include "voxels/occupancy_channels.hpp"
 #include "voxels/voxel_image.hpp"
+#include "voxels/voxels_record.hpp"
 
 using namespace qte;
 
@@ -88,54 +86,22 @@ static void run(const cli::Arguments& args) {
   if (!png_dir.empty() && ::mkdir(png_dir.c_str(), 0755) != 0 && errno != EEXIST)
     throw_system_error("cannot create directory " + png_dir);
 
-  const int64_t v = scene.voxels;
-  const std::size_t grid_floats = static_cast<std::size_t>(v * v * v) * voxels::kChannels;
+  const std::size_t grid_floats = static_cast<std::size_t>(scene.voxels) * scene.voxels * scene.voxels * voxels::kChannels;
   stream::RecordReader reader(args.positional().empty() ? "-" : args.positional()[0]);
   stream::RecordWriter writer(args.text("output"));
-  std::vector<float> grid(grid_floats), crop_grids(grid_floats * crops.size());
   while (auto record = reader.next()) {
     writer.write(*record);
     if (record->type() != "obs") continue;
-    const voxels::ObservationCloud cloud = voxels::observation_cloud(*record);
-    voxels::voxelize(cloud.view(), scene, grid.data());
-    std::unique_ptr<voxels::ObservedSpace> space;
-    if (octomap_channels) space = std::make_unique<voxels::ObservedSpace>(*record);
-    // The grid with the OctoMap channels appended when asked for.
-    auto with_channels = [&](const float* g, const voxels::GridBounds& bounds) {
-      if (!space) return std::vector<float>(g, g + grid_floats);
-      std::vector<float> extra(static_cast<std::size_t>(v * v * v) * voxels::kOccupancyChannels);
-      space->channels(bounds, extra.data());
-      return voxels::append_channels(g, extra.data(), scene.voxels, voxels::kOccupancyChannels);
-    };
-    const int64_t channels = voxels::kChannels + (space ? voxels::kOccupancyChannels : 0);
-    stream::Record out("voxels");
-    out.set<float>("depth0.grid", {v, v, v, channels}, with_channels(grid.data(), scene));
-    out.set<double>("depth0.bounds", {4}, voxels::bounds_values(scene));
-    if (!crops.empty()) {
-      voxels::voxelize_many(cloud.view(), crops, crop_grids.data());
-      const int64_t k = static_cast<int64_t>(crops.size());
-      std::vector<double> bounds;
-      for (const auto& c : crops) {
-        const std::vector<double> b = voxels::bounds_values(c);
-        bounds.insert(bounds.end(), b.begin(), b.end());
-      }
-      std::vector<float> all;
-      for (std::size_t c = 0; c < crops.size(); ++c) {
-        const auto one = with_channels(crop_grids.data() + c * grid_floats, crops[c]);
-        all.insert(all.end(), one.begin(), one.end());
-      }
-      out.set<float>("depth1.grid", {k, v, v, v, channels}, all);
-      out.set<double>("depth1.bounds", {k, 4}, bounds);
-    }
+    const voxels::VoxelsOfObservation out = voxels::voxels_of(*record, {scene, crops, octomap_channels});
     if (!png_dir.empty()) {
       char index[16];
       std::snprintf(index, sizeof index, "%06llu", static_cast<unsigned long long>(record->position.record_index));
-      voxels::save_voxel_png(png_dir + "/" + index + ".depth0.png", grid.data(), scene.voxels);
+      voxels::save_voxel_png(png_dir + "/" + index + ".depth0.png", out.grids.data(), scene.voxels);
       for (std::size_t c = 0; c < crops.size(); ++c)
         voxels::save_voxel_png(png_dir + "/" + index + ".depth1." + std::to_string(c) + ".png",
-                               crop_grids.data() + c * grid_floats, scene.voxels);
+                               out.grids.data() + (1 + c) * grid_floats, scene.voxels);
     }
-    writer.write(out);
+    writer.write(out.record);
   }
   writer.close();
 }

@@ -1,0 +1,47 @@
+#include "voxels/voxels_record.hpp"
+
+#include <memory>
+
+#include "voxels/grid_fields.hpp"
+#include "voxels/observation_cloud.hpp"
+#include "voxels/occupancy_channels.hpp"
+
+namespace qte::voxels {
+
+VoxelsOfObservation voxels_of(const stream::Record& obs, const VoxelsRecordOptions& options) {
+  const int64_t v = options.scene.voxels, k = static_cast<int64_t>(options.crops.size());
+  const std::size_t grid_floats = static_cast<std::size_t>(v * v * v) * kChannels;
+  const ObservationCloud cloud = observation_cloud(obs);
+  VoxelsOfObservation out;
+  out.grids.resize(grid_floats * (1 + options.crops.size()));
+  voxelize(cloud.view(), options.scene, out.grids.data());
+  if (!options.crops.empty()) voxelize_many(cloud.view(), options.crops, out.grids.data() + grid_floats);
+
+  std::unique_ptr<ObservedSpace> space;
+  if (options.occupancy_channels) space = std::make_unique<ObservedSpace>(obs);
+  // Grid `i` of out.grids, with the OctoMap channels appended when asked for.
+  const auto with_channels = [&](std::size_t i, const GridBounds& bounds) {
+    const float* g = out.grids.data() + i * grid_floats;
+    if (!space) return std::vector<float>(g, g + grid_floats);
+    std::vector<float> extra(static_cast<std::size_t>(v * v * v) * kOccupancyChannels);
+    space->channels(bounds, extra.data());
+    return append_channels(g, extra.data(), static_cast<int>(v), kOccupancyChannels);
+  };
+  const int64_t channels = kChannels + (space ? kOccupancyChannels : 0);
+  out.record.set<float>("depth0.grid", {v, v, v, channels}, with_channels(0, options.scene));
+  out.record.set<double>("depth0.bounds", {4}, bounds_values(options.scene));
+  if (options.crops.empty()) return out;
+  std::vector<float> grids;
+  std::vector<double> bounds;
+  for (std::size_t c = 0; c < options.crops.size(); ++c) {
+    const std::vector<float> one = with_channels(1 + c, options.crops[c]);
+    grids.insert(grids.end(), one.begin(), one.end());
+    const std::vector<double> b = bounds_values(options.crops[c]);
+    bounds.insert(bounds.end(), b.begin(), b.end());
+  }
+  out.record.set<float>("depth1.grid", {k, v, v, v, channels}, grids);
+  out.record.set<double>("depth1.bounds", {k, 4}, bounds);
+  return out;
+}
+
+}  // namespace qte::voxels
