@@ -155,7 +155,7 @@ void TrainingLoop::run() {
   try {
     train();
   } catch (...) {
-    if (fresh_ && last_saved_ == 0) {  // only the initial weights were saved: not worth keeping
+    if (only_initial_weights_saved()) {
       checkpoints_.discard(0);
       metrics_.close();
       if (!options_.metrics_path.empty()) std::filesystem::remove(options_.metrics_path);
@@ -199,7 +199,7 @@ void TrainingLoop::train() {
         records += (i ? "; " : "") + replay_.transition(sample.indices[i]).position.describe();
       throw Error("step " + std::to_string(step) + ": " + e.what() + " in the batch of " + records +
                   (sample.indices.size() > 8 ? "; ..." : "") +
-                  (fresh_ && last_saved_ == 0 ? " (no trained checkpoint was saved: none is kept)"
+                  (only_initial_weights_saved() ? " (no trained checkpoint was saved: none is kept)"
                                               : " (the last good checkpoint is " + checkpoints_.path_for(last_saved_) + ")"));
     }
     for (std::size_t index : sample.indices) priority_sum_ += replay_.priority(index);

@@ -80,6 +80,8 @@ class TrainingLoop {
   std::deque<stream::Record> pending_;
   int64_t transitions_read_ = 0, agent_transitions_ = 0, last_saved_ = -1;
   bool fresh_ = false;  // started without a checkpoint to resume
+  // A fresh run that saved only its initial weights: nothing worth keeping if it fails.
+  bool only_initial_weights_saved() const { return fresh_ && last_saved_ == 0; }
   std::ofstream metrics_;
   std::chrono::steady_clock::time_point started_, window_start_;
   int64_t window_steps_ = 0, td_count_ = 0;

@@ -10,13 +10,14 @@
 #include "planning/occupancy_scene.hpp"
 #include "planning/robot_spheres.hpp"
 #include "robot/robot_model.hpp"
+#include "world/scene_layout.hpp"
 
 namespace qte::planning {
 
 struct CollisionCheckOptions {
   double clearance_m = 0.0;      // extra distance kept from occupied voxels
   double check_step_rad = 0.02;  // motions are checked at least every this much of any joint
-  double table_height_m = 0.752;
+  double table_height_m = world::SceneLayout::kTableHeight_m;
 };
 
 class CollisionChecker {

@@ -4,8 +4,8 @@
 // go through every setting, interleaved batch by batch so that a noisy machine slows all of
 // them alike. Per setting: the median seconds of one target computation (the next states'
 // voxelization included), the mean grids expanded per node at depth 1, and the mean absolute
-// difference of the depth-0 target from K = 10's (every sample bootstrapping, terminal or not). bench_adaptive_k runs it after the acting
-// figures, on the same checkpoint.
+// difference of the depth-0 target from K = 10's (every sample bootstrapping, terminal or
+// not). bench_adaptive_k runs it after the acting figures, on the same checkpoint.
 //
 // Usage: tree_target_timing CHECKPOINT REPLAY [BATCHES [THREADS]]   (defaults 10 batches of 32, 2 threads)
 #include <algorithm>

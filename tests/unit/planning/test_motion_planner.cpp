@@ -115,7 +115,7 @@ TEST(MotionPlanner, PathsAreCollisionFreeInTheTrueScene) {
     // Goals just above each block, and beyond it: paths must pass the blocks.
     for (const char* name : {"target", "distractor1", "distractor2"}) {
       const Eigen::Vector3d block = scene.world().object_pose(scene.world().object_id(name)).translation();
-      for (const Eigen::Vector3d offset : {Eigen::Vector3d(0, 0, 0.09), Eigen::Vector3d(0.0, 0.12, 0.05)}) {
+      for (const Eigen::Vector3d& offset : {Eigen::Vector3d(0, 0, 0.09), Eigen::Vector3d(0.0, 0.12, 0.05)}) {
         const PlanResult plan = planner.plan(start, pose_goal(block + offset), occupancy, planned);
         if (!plan.failure.empty()) continue;  // e.g. goal_in_collision next to another block
         ++planned;
