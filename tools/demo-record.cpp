@@ -4,6 +4,7 @@
 #include "cli/command.hpp"
 #include "demos/demo_recorder.hpp"
 #include "stream/writer.hpp"
+#include "tasks/task.hpp"
 
 using namespace qte;
 
@@ -22,7 +23,7 @@ static cli::Usage usage() {
       "said per episode.",
   };
   u.options = {
-      {"task", "T", "reach_target, pick_and_lift, lift_numbered_block, reach_prism, pick_and_lift_small, stack_blocks or setup_checkers", ""},
+      {"task", "T", "one of: " + tasks::task_list(), ""},
       {"episodes", "N", "number of demonstrations", "10"},
       {"variation", "V", "task variation, or 'random' for one per episode", "0"},
       {"scenes", "SET", "the scene set episodes are drawn from: demo (disjoint from sim-step's explore and eval "

@@ -5,6 +5,7 @@
 #include "sim_step/simulator.hpp"
 #include "stream/reader.hpp"
 #include "stream/writer.hpp"
+#include "tasks/task.hpp"
 
 using namespace qte;
 
@@ -33,8 +34,7 @@ static cli::Usage usage() {
       "winds down without broken pipes.",
       "Cameras are rendered without a GPU, one ray per pixel against Bullet's collision world, "
       "with per-object colours, diffuse shading and textures (the digits of lift_numbered_block, "
-      "the board of setup_checkers). Tasks: reach_target, pick_and_lift, lift_numbered_block, reach_prism, "
-      "pick_and_lift_small, stack_blocks, setup_checkers.",
+      "the board of setup_checkers). Tasks: " + tasks::task_list() + ".",
   };
   u.arguments = {{"FILE", "input records; '-' or absent is standard input", true, false}};
   u.options = {

@@ -17,22 +17,30 @@ world::ObjectSpec block(const world::World& world, const std::string& name, cons
   return spec;
 }
 
+std::vector<Waypoint> grasp_at(const Eigen::Vector3d& centre, double yaw_rad, double lift_m) {
+  Waypoint above, grasp, lift;
+  above.tcp_pose.linear() = grasp.tcp_pose.linear() = lift.tcp_pose.linear() = top_down(yaw_rad);
+  grasp.tcp_pose.translation() = centre;
+  above.tcp_pose.translation() = centre + Eigen::Vector3d(0, 0, 0.1);
+  lift.tcp_pose.translation() = centre + Eigen::Vector3d(0, 0, lift_m);
+  grasp.gripper_open = false;
+  grasp.ignore_collisions = true;  // the straight approach touches the object on purpose
+  lift.gripper_open = false;
+  lift.ignore_collisions = true;
+  return {above, grasp, lift};
+}
+
 std::vector<Waypoint> grasp_and_lift(const world::World& world, int block_id, double lift_m) {
   const Eigen::Isometry3d pose = world.object_pose(block_id);
   // Fingers close across two opposite faces: the block's yaw modulo a quarter turn.
   const Eigen::Vector3d x_axis = pose.linear().col(0);
-  double yaw = std::atan2(x_axis.y(), x_axis.x());
-  yaw = std::remainder(yaw, M_PI / 2);
-  Waypoint above, grasp, lift;
-  above.tcp_pose.linear() = grasp.tcp_pose.linear() = lift.tcp_pose.linear() = top_down(yaw);
-  grasp.tcp_pose.translation() = pose.translation();
-  above.tcp_pose.translation() = pose.translation() + Eigen::Vector3d(0, 0, 0.1);
-  lift.tcp_pose.translation() = pose.translation() + Eigen::Vector3d(0, 0, lift_m);
-  grasp.gripper_open = false;
-  grasp.ignore_collisions = true;  // the straight approach touches the block on purpose
-  lift.gripper_open = false;
-  lift.ignore_collisions = true;
-  return {above, grasp, lift};
+  return grasp_at(pose.translation(), std::remainder(std::atan2(x_axis.y(), x_axis.x()), M_PI / 2), lift_m);
+}
+
+Eigen::Vector3d grasp_point(const world::World& world, int object_id) {
+  const Eigen::AlignedBox3d& region = world.object_spec(object_id).grasp_region;
+  const Eigen::Isometry3d pose = world.object_pose(object_id);
+  return region.isEmpty() ? pose.translation() : Eigen::Vector3d(pose * region.center());
 }
 
 std::vector<Waypoint> place_at(const Eigen::Vector3d& resting_centre, double yaw_rad, double above_m) {

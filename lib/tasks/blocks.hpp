@@ -12,9 +12,14 @@ constexpr double kBlockSize = 0.05;
 world::ObjectSpec block(const world::World& world, const std::string& name, const Eigen::Vector3d& xy,
                       double yaw_rad, const Eigen::Vector3f& colour);
 
-// Pre-grasp above the block, grasp at its centre (gripper closes), then lift straight up by
-// `lift_m`: the first three waypoints of every pick task.
+// Pre-grasp 10 cm above `centre`, grasp there (gripper closes; TCP x along world yaw
+// `yaw_rad`, so the fingers close across it), then lift straight up by `lift_m`: the first
+// three waypoints of every pick task.
+std::vector<Waypoint> grasp_at(const Eigen::Vector3d& centre, double yaw_rad, double lift_m);
+// grasp_at the block's centre, square to its faces.
 std::vector<Waypoint> grasp_and_lift(const world::World& world, int block_id, double lift_m);
+// Where the fingers close on an object (world frame): its grasp region's centre, or its origin.
+Eigen::Vector3d grasp_point(const world::World& world, int object_id);
 
 // Placing the held object: over `resting_centre` (where its centre will rest) by `above_m`,
 // down to 5 mm over it, the gripper opening there (released; physics settles it), back up;

@@ -9,7 +9,8 @@ namespace qte::tasks {
 
 std::vector<std::string> task_names() {
   return {"reach_target", "pick_and_lift", "lift_numbered_block", "reach_prism", "pick_and_lift_small",
-          "stack_blocks", "setup_checkers"};
+          "stack_blocks", "setup_checkers", "take_lid_off_saucepan", "pick_up_cup", "put_rubbish_in_bin",
+          "stack_wine", "phone_on_base", "take_umbrella_out_of_umbrella_stand"};
 }
 
 std::unique_ptr<Task> make_task(const std::string& name) {
@@ -20,9 +21,19 @@ std::unique_ptr<Task> make_task(const std::string& name) {
   if (name == "pick_and_lift_small") return make_pick_and_lift_small();
   if (name == "stack_blocks") return make_stack_blocks();
   if (name == "setup_checkers") return make_setup_checkers();
-  std::string known;
-  for (const auto& n : task_names()) known += (known.empty() ? "" : ", ") + n;
-  throw Error("unknown task '" + name + "' (known tasks: " + known + ")");
+  if (name == "take_lid_off_saucepan") return make_take_lid_off_saucepan();
+  if (name == "pick_up_cup") return make_pick_up_cup();
+  if (name == "put_rubbish_in_bin") return make_put_rubbish_in_bin();
+  if (name == "stack_wine") return make_stack_wine();
+  if (name == "phone_on_base") return make_phone_on_base();
+  if (name == "take_umbrella_out_of_umbrella_stand") return make_take_umbrella_out_of_umbrella_stand();
+  throw Error("unknown task '" + name + "' (known tasks: " + task_list() + ")");
+}
+
+std::string task_list() {
+  std::string list;
+  for (const auto& n : task_names()) list += (list.empty() ? "" : ", ") + n;
+  return list;
 }
 
 Eigen::Matrix3d top_down(double yaw_rad) {

@@ -41,9 +41,11 @@ class Task {
 // The tasks by name; an unknown name is an Error listing the known ones.
 std::unique_ptr<Task> make_task(const std::string& name);
 std::vector<std::string> task_names();
+// The names joined by ", " (for usage texts and errors).
+std::string task_list();
 
-// A top-down gripper orientation (TCP z pointing down) with the fingers closing along the
-// world direction at angle `yaw_rad` about z.
+// A top-down gripper orientation (TCP z pointing down), TCP x along the world direction at
+// angle `yaw_rad` about z; the fingers close along TCP y, across that direction.
 Eigen::Matrix3d top_down(double yaw_rad);
 
 }  // namespace qte::tasks

@@ -279,11 +279,18 @@ int World::close_gripper() {
   for (int id = 0; id < object_count(); ++id) {
     const ObjectSpec& spec = impl_->specs[id];
     if (!spec.graspable || spec.mass_kg <= 0) continue;
-    const Eigen::Isometry3d in_tcp = tcp.inverse() * object_pose(id);
-    // Half extent of the object along the closing axis (tcp y), from its bounding box.
-    btVector3 lo, hi;
-    impl_->objects[id].shape->getAabb(btTransform::getIdentity(), lo, hi);
-    const Eigen::Vector3d half((hi - lo).x() / 2, (hi - lo).y() / 2, (hi - lo).z() / 2);
+    // The grasped part's centre in the TCP frame and its half extents (object frame): the
+    // grasp region, or else the object's bounding box about its origin.
+    Eigen::Isometry3d in_tcp = tcp.inverse() * object_pose(id);
+    Eigen::Vector3d half;
+    if (spec.grasp_region.isEmpty()) {
+      btVector3 lo, hi;
+      impl_->objects[id].shape->getAabb(btTransform::getIdentity(), lo, hi);
+      half << (hi - lo).x() / 2, (hi - lo).y() / 2, (hi - lo).z() / 2;
+    } else {
+      in_tcp = in_tcp * Eigen::Translation3d(spec.grasp_region.center());
+      half = spec.grasp_region.sizes() / 2;
+    }
     const double half_y = (in_tcp.linear().row(1).cwiseAbs()) * half;
     const double half_x = (in_tcp.linear().row(0).cwiseAbs()) * half;
     const Eigen::Vector3d c = in_tcp.translation();

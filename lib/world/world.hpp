@@ -37,6 +37,9 @@ struct ObjectSpec {
   double mass_kg = 0.1;     // 0: static (never moves)
   bool collides = true;     // false: seen by cameras only (e.g. a success zone)
   bool graspable = true;
+  // The part the fingers close on (object frame), for objects held by a knob or a handle;
+  // empty: the whole object, taken as centred on its origin.
+  Eigen::AlignedBox3d grasp_region;
   render::Appearance appearance;
 };
 
