@@ -1,7 +1,7 @@
 # The two commands of the README, plus the targets they are made of.
 #   make demo    install what is missing, build, run the main job on the built-in tasks
 #   make check   install what is missing, build, run every test (ctest)
-# Other targets: deps, build, install, sanitize, fuzz, man, bench, clean.
+# Other targets: deps, build, check-slow, check-slurm, install, sanitize, fuzz, man, bench, clean.
 
 BUILD    ?= build
 JOBS     ?= $(shell nproc)
@@ -11,7 +11,7 @@ FUZZ_SECONDS ?= 600
 APT_PACKAGES := $(shell sed -e 's/\#.*//' debian-packages.txt)
 TOOLS := $(basename $(notdir $(wildcard tools/*.cpp)))
 
-.PHONY: all deps build check check-slow demo install sanitize fuzz man bench clean
+.PHONY: all deps build check check-slow check-slurm demo install sanitize fuzz man bench clean
 
 all: build
 
@@ -30,12 +30,18 @@ $(BUILD)/CMakeCache.txt: | deps
 build: deps $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS)
 
-# Every test except those labelled slow (see check-slow).
+# Every test except those labelled slow (see check-slow) or slurm (see check-slurm).
 check: build
-	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) -LE slow
+	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) -LE 'slow|slurm'
 
 check-slow: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) -L slow
+
+# The cluster tests: a throwaway single-node Slurm cluster (Debian's slurm-wlm and munge, from
+# debian-packages-slurm.txt) runs an experiment grid and a split run (tests/slurm/).
+check-slurm: build
+	$(MAKE) deps APT_PACKAGES="$$(sed -e 's/#.*//' debian-packages-slurm.txt)"
+	ctest --test-dir $(BUILD) --output-on-failure -L slurm
 
 demo: build
 	PATH="$(CURDIR)/$(BUILD)/tools:$$PATH" bash examples/demo.sh
@@ -48,7 +54,7 @@ sanitize: deps
 	cmake -S . -B $(BUILD)-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DQTE_SANITIZE=ON $(CMAKE_FLAGS)
 	cmake --build $(BUILD)-asan -j $(JOBS)
 	ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
-	  ctest --test-dir $(BUILD)-asan --output-on-failure -j $(JOBS) -LE slow
+	  ctest --test-dir $(BUILD)-asan --output-on-failure -j $(JOBS) -LE 'slow|slurm'
 
 # libFuzzer for FUZZ_SECONDS per target (clang from debian-packages.txt): the stream decoder,
 # then each record type's readers (tests/fuzz/fuzz_<target>.cpp, seeds in tests/fuzz/corpus/<target>/).

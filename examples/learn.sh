@@ -27,13 +27,20 @@
 # replay depends on timing, so a run is no longer a function of its seed alone. An actor that
 # dies (killed, out of memory) costs only its own chunk: the others finish theirs and the
 # chunk is run again in the next round (twice failed: the run stops).
+#
+# ROLE=learner / ROLE=actor (ACTOR_INDEX=i of ACTORS) split one run over processes that meet
+# only through RUN_DIR, for a cluster (examples/slurm/): the learner role records the
+# demonstrations, trains and evaluates; actor i runs chunks i, i + ACTORS, ... and appends its
+# episodes to its own replay file, actors/replay-i.rec, which the learner follows. No FIFO,
+# PID or lock crosses roles; each role is resumable on its own. ROLE=all (the default) is the
+# whole loop in this one process tree, as above. CPU_BUDGET is for ROLE=all only.
 set -euo pipefail
 task=$1 run=$2
 : "${SEED:=0}" "${DEMOS:=10}" "${VARIATION:=0}" "${IMAGE:=128x128}" "${ACT_K:=10}" "${TARGET_K:=10}"
 : "${ENV_STEPS:=2000}" "${CHUNK_EPISODES:=10}" "${EVAL_EVERY:=250}" "${EVAL_EPISODES:=50}" "${EVAL_SEED:=1000000}"
 : "${ARCH:=light}" "${BATCH:=32}" "${RATIO:=0.5}" "${PRETRAIN:=200}" "${START_AFTER:=0}"
 : "${LEARNER_THREADS:=1}" "${EPSILON:=0.1}" "${ROTATION_NOISE:=1}" "${CHECKPOINT_EVERY:=25}" "${LABEL:=k$ACT_K-$TARGET_K}"
-: "${N_STEP:=1}" "${ACTORS:=1}" "${CPU_BUDGET:=0}" "${K_MARGIN:=0.02}" "${K_MAX:=10}"
+: "${N_STEP:=1}" "${ACTORS:=1}" "${CPU_BUDGET:=0}" "${K_MARGIN:=0.02}" "${K_MAX:=10}" "${ROLE:=all}" "${ACTOR_INDEX:=0}"
 mkdir -p "$run/chunks" "$run/eval"
 # Adaptive K (ACT_K or TARGET_K 'auto'): each node expands the voxels within K_MARGIN of its
 # best Q, at most K_MAX; the options go only to the programs whose K is 'auto'.
@@ -73,6 +80,60 @@ count_training_time() {
 # the budget measures).
 out_of_budget() { [ "$CPU_BUDGET" -gt 0 ] && [ "$(cpu_seconds)" -ge "$CPU_BUDGET" ]; }
 
+# One chunk of exploring episodes through the closed loop -> chunks/NNNN.rec; its episodes are
+# appended to `actor_replay` as they finish.
+actor_replay=$run/replay.rec
+[ "$ROLE" != actor ] || actor_replay=$run/actors/replay-$ACTOR_INDEX.rec
+run_chunk() {  # CHUNK
+  local name fifo seed
+  name=$run/chunks/$(printf '%04d' "$1") seed=$((SEED * 100000 + $1))
+  fifo=$(mktemp -u); mkfifo "$fifo"
+  if ! sim-step --task "$task" --variation "$VARIATION" --episodes "$CHUNK_EPISODES" --seed "$seed" \
+      --scenes explore --image-size "$IMAGE" --compress < "$fifo" \
+    | qte-select --checkpoint "$run/ckpt/latest.rec" --reload --k "$ACT_K" $act_branching --epsilon "$EPSILON" \
+        --rotation-noise "$ROTATION_NOISE" --seed "$seed" --threads 1 2>> "$run/actor.log" \
+    | plan-path | tee "$fifo" "$name.partial" \
+    | keyframe --agent --seed "$SEED" --append --output "$actor_replay" 2>> "$run/actor.log"; then
+    rm -f "$fifo"
+    return 1
+  fi
+  rm -f "$fifo"
+  mv "$name.partial" "$name.rec"
+}
+# Environment steps of the finished chunks (each counted once, into chunks/NNNN.steps; written
+# under a name of this process's own, since roles on other nodes count too).
+finished_steps() {
+  local f n=0
+  for f in "$run"/chunks/*.rec; do
+    [ -f "$f" ] || continue
+    if [ ! -f "${f%.rec}.steps" ]; then
+      stream-dump --summary "$f" | awk '$1 == "action" { print $2 }' > "${f%.rec}.steps.$$"
+      mv "${f%.rec}.steps.$$" "${f%.rec}.steps"
+    fi
+    n=$(( n + $(cat "${f%.rec}.steps") ))
+  done
+  echo "$n"
+}
+
+# Actor i of a split run: chunks i, i + ACTORS, ... until the run has its environment steps or
+# the learner says it is done; each chunk that fails is tried once more.
+if [ "$ROLE" = actor ]; then
+  mkdir -p "$run/actors"
+  until [ -f "$run/ckpt/latest.rec" ]; do sleep 2; done
+  chunk=$ACTOR_INDEX tries=0
+  while [ ! -f "$run/actor.done" ] && [ "$(finished_steps)" -lt "$ENV_STEPS" ]; do
+    if [ -f "$run/chunks/$(printf '%04d' "$chunk").rec" ] || run_chunk "$chunk"; then
+      chunk=$((chunk + ACTORS)) tries=0
+    else
+      tries=$((tries + 1))
+      log "$task $LABEL seed $SEED: actor $ACTOR_INDEX: chunk $chunk failed (attempt $tries)"
+      [ "$tries" -lt 2 ] || exit 1
+    fi
+  done
+  log "$task $LABEL seed $SEED: actor $ACTOR_INDEX done"
+  exit 0
+fi
+
 # 1. Demonstrations -> transitions (once; written under a temporary name, then renamed).
 if [ ! -f "$run/replay.rec" ]; then
   log "$task: $DEMOS demonstrations"
@@ -82,12 +143,18 @@ if [ ! -f "$run/replay.rec" ]; then
   mv "$run/replay.rec.tmp" "$run/replay.rec"
 fi
 
-# 2. The learner, in the background for the whole run.
+# 2. The learner, in the background for the whole run; with ROLE=learner it follows the
+# actors' replay files too (made empty here if no actor has started yet).
+inputs=("$run/replay.rec")
+if [ "$ROLE" = learner ]; then
+  mkdir -p "$run/actors"
+  for ((i = 0; i < ACTORS; i++)); do touch "$run/actors/replay-$i.rec"; inputs+=("$run/actors/replay-$i.rec"); done
+fi
 rm -f "$run/actor.done"
 qattn-train --follow --resume --stop-file "$run/actor.done" --replay-ratio "$RATIO" --pretrain "$PRETRAIN" \
   --start-after "$START_AFTER" --steps 1000000 --checkpoint-every "$CHECKPOINT_EVERY" --keep 4 \
   --architecture "$ARCH" --batch "$BATCH" --tree-target "$TARGET_K" $target_branching --n-step "$N_STEP" --seed "$SEED" --threads "$LEARNER_THREADS" \
-  --checkpoint-dir "$run/ckpt" --metrics "$run/train.csv" "$run/replay.rec" 2>> "$run/train.log" &
+  --checkpoint-dir "$run/ckpt" --metrics "$run/train.csv" "${inputs[@]}" 2>> "$run/train.log" &
 learner=$!
 trap 'kill $(jobs -p) 2>/dev/null || true' EXIT  # the learner and any actor still running
 while [ ! -f "$run/ckpt/latest.rec" ]; do kill -0 $learner || { tail -2 "$run/train.log"; exit 1; }; sleep 0.5; done
@@ -116,34 +183,6 @@ evaluate() {  # CHECKPOINT ENV_STEPS OUT.csv LEARNER_STEP EVAL_POINT
   mv "$3.tmp" "$3"
 }
 
-# One chunk of exploring episodes through the closed loop -> chunks/NNNN.rec.
-run_chunk() {  # CHUNK
-  local name fifo seed
-  name=$run/chunks/$(printf '%04d' "$1") seed=$((SEED * 100000 + $1))
-  fifo=$(mktemp -u); mkfifo "$fifo"
-  if ! sim-step --task "$task" --variation "$VARIATION" --episodes "$CHUNK_EPISODES" --seed "$seed" \
-      --scenes explore --image-size "$IMAGE" --compress < "$fifo" \
-    | qte-select --checkpoint "$run/ckpt/latest.rec" --reload --k "$ACT_K" $act_branching --epsilon "$EPSILON" \
-        --rotation-noise "$ROTATION_NOISE" --seed "$seed" --threads 1 2>> "$run/actor.log" \
-    | plan-path | tee "$fifo" "$name.partial" \
-    | keyframe --agent --seed "$SEED" --append --output "$run/replay.rec" 2>> "$run/actor.log"; then
-    rm -f "$fifo"
-    return 1
-  fi
-  rm -f "$fifo"
-  mv "$name.partial" "$name.rec"
-}
-# Environment steps of the finished chunks (each counted once, into chunks/NNNN.steps).
-finished_steps() {
-  local f n=0
-  for f in "$run"/chunks/*.rec; do
-    [ -f "$f" ] || continue
-    [ -f "${f%.rec}.steps" ] || stream-dump --summary "$f" | awk '$1 == "action" { print $2 }' > "${f%.rec}.steps"
-    n=$(( n + $(cat "${f%.rec}.steps") ))
-  done
-  echo "$n"
-}
-
 declare -A failures=()
 while :; do
   env_steps=$(finished_steps)
@@ -167,6 +206,8 @@ while :; do
     log "$task $LABEL seed $SEED: env steps $env_steps, learner step $step: $(tail -1 "$eval_csv")"
   fi
   [ "$finished" = 0 ] || break
+  # A split run's learner: the actors (elsewhere) add chunks; look again in a while.
+  if [ "$ROLE" = learner ]; then sleep 5; continue; fi
 
   # One round: the next ACTORS chunks not yet finished, side by side.
   round=() chunk=0
