@@ -42,6 +42,10 @@ std::vector<Eigen::Vector3d> place_one_by_one(std::mt19937_64& rng, int count, c
 // A point uniform in the box [lo, hi] at least `min_distance_m` from each of `others`.
 Eigen::Vector3d sample_away_from(std::mt19937_64& rng, const std::vector<Eigen::Vector3d>& others,
                                  const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double min_distance_m);
+// A number uniform in [lo, hi).
+inline double uniform(std::mt19937_64& rng, double lo, double hi) {
+  return std::uniform_real_distribution<double>(lo, hi)(rng);
+}
 // `count` distinct integers in [0, range), none equal to `excluded`.
 std::vector<int> pick_distinct(std::mt19937_64& rng, int count, int range, int excluded);
 

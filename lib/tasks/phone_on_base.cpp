@@ -19,22 +19,21 @@ class PhoneOnBase : public Task {
   std::string description(int) const override { return "put the phone on the base"; }
 
   void build(world::World& world, int, std::mt19937_64& rng) override {
-    auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
-    const double table = world.layout().table_height_m, side = uniform(0, 1) < 0.5 ? -1 : 1;
+    const double table = world.layout().table_height_m, side = uniform(rng, 0, 1) < 0.5 ? -1 : 1;
     auto box = [&](const std::string& name, const Eigen::Vector3d& size, double y, const Eigen::Vector3f& colour) {
       world::ObjectSpec spec;
       spec.name = name;
       spec.size = size;
-      spec.pose.linear() = Eigen::AngleAxisd(uniform(-M_PI / 4, M_PI / 4), Eigen::Vector3d::UnitZ()).toRotationMatrix();
-      spec.pose.translation() << uniform(0.05, 0.25), y, table + size.z() / 2;
+      spec.pose.linear() = Eigen::AngleAxisd(uniform(rng, -M_PI / 4, M_PI / 4), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      spec.pose.translation() << uniform(rng, 0.05, 0.25), y, table + size.z() / 2;
       spec.appearance.colour = colour;
       return spec;
     };
-    world::ObjectSpec base = box("base", kBase, side * uniform(0.1, 0.18), {0.8f, 0.8f, 0.85f});
+    world::ObjectSpec base = box("base", kBase, side * uniform(rng, 0.1, 0.18), {0.8f, 0.8f, 0.85f});
     base.mass_kg = 0;
     base.graspable = false;
     world.add_object(base);
-    world::ObjectSpec phone = box("phone", kPhone, -side * uniform(0.08, 0.18), {0.08f, 0.08f, 0.12f});
+    world::ObjectSpec phone = box("phone", kPhone, -side * uniform(rng, 0.08, 0.18), {0.08f, 0.08f, 0.12f});
     phone.mass_kg = 0.15;
     world.add_object(phone);
   }

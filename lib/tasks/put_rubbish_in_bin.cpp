@@ -51,13 +51,12 @@ class PutRubbishInBin : public Task {
   std::string description(int) const override { return "put rubbish in bin"; }
 
   void build(world::World& world, int, std::mt19937_64& rng) override {
-    auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
     const double table = world.layout().table_height_m;
     // The bin on one side (its origin: the centre of its floor's underside), the rest on the other.
-    const double side = uniform(0, 1) < 0.5 ? -1 : 1;
+    const double side = uniform(rng, 0, 1) < 0.5 ? -1 : 1;
     Eigen::Isometry3d bin = Eigen::Isometry3d::Identity();
-    bin.linear() = Eigen::AngleAxisd(uniform(-0.3, 0.3), Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    bin.translation() << uniform(0.1, 0.2), side * uniform(0.14, 0.2), table;
+    bin.linear() = Eigen::AngleAxisd(uniform(rng, -0.3, 0.3), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    bin.translation() << uniform(rng, 0.1, 0.2), side * uniform(rng, 0.14, 0.2), table;
     const Eigen::Vector3d h = kBinSize / 2;
     world.add_object(solid("bin", {box_piece({-h.x(), -h.y(), 0}, {h.x(), h.y(), kBinWall}),
                                    box_piece({-h.x(), -h.y(), 0}, {-h.x() + kBinWall, h.y(), kBinSize.z()}),

@@ -31,10 +31,9 @@ class SetupCheckers : public Task {
 
   void build(world::World& world, int variation, std::mt19937_64& rng) override {
     const double table = world.layout().table_height_m;
-    auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
     Eigen::Isometry3d board = Eigen::Isometry3d::Identity();
-    board.linear() = Eigen::AngleAxisd(uniform(-0.15, 0.15), Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    board.translation() << uniform(0.10, 0.14), uniform(-0.03, 0.03), table + kBoardThickness / 2;
+    board.linear() = Eigen::AngleAxisd(uniform(rng, -0.15, 0.15), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    board.translation() << uniform(rng, 0.10, 0.14), uniform(rng, -0.03, 0.03), table + kBoardThickness / 2;
     world::ObjectSpec spec;
     spec.name = "board";
     spec.size = Eigen::Vector3d(8 * kSquare, 8 * kSquare, kBoardThickness);

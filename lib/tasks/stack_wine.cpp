@@ -34,13 +34,12 @@ class StackWine : public Task {
   std::string description(int) const override { return "stack wine bottle"; }
 
   void build(world::World& world, int, std::mt19937_64& rng) override {
-    auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
     const double table = world.layout().table_height_m;
-    const double side = uniform(0, 1) < 0.5 ? -1 : 1;
+    const double side = uniform(rng, 0, 1) < 0.5 ? -1 : 1;
     // The rack (origin: the centre of its plate's underside), the slot along its x axis.
     Eigen::Isometry3d rack = Eigen::Isometry3d::Identity();
-    rack.linear() = Eigen::AngleAxisd(uniform(-M_PI / 4, M_PI / 4), Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    rack.translation() << uniform(0.1, 0.2), side * uniform(0.13, 0.18), table;
+    rack.linear() = Eigen::AngleAxisd(uniform(rng, -M_PI / 4, M_PI / 4), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    rack.translation() << uniform(rng, 0.1, 0.2), side * uniform(rng, 0.13, 0.18), table;
     const double rx = kRackHalfSize.x(), rail = kSlotHalfWidth + kRailWidth;
     world.add_object(solid("rack", {box_piece({-rx, -kRackHalfSize.y(), 0}, {rx, kRackHalfSize.y(), kPlate}),
                                     box_piece({-rx, kSlotHalfWidth, kPlate}, {rx, rail, kPlate + kRailHeight}),
@@ -49,8 +48,8 @@ class StackWine : public Task {
 
     // The bottle on the other side, lying along a yaw within +-45 degrees.
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-    pose.linear() = Eigen::AngleAxisd(uniform(-M_PI / 4, M_PI / 4), Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    pose.translation() << uniform(0.05, 0.2), -side * uniform(0.1, 0.16), table + lying_height();
+    pose.linear() = Eigen::AngleAxisd(uniform(rng, -M_PI / 4, M_PI / 4), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    pose.translation() << uniform(rng, 0.05, 0.2), -side * uniform(rng, 0.1, 0.16), table + lying_height();
     world::ObjectSpec spec = solid("wine_bottle", bottle(), pose, {0.1f, 0.35f, 0.15f});
     spec.mass_kg = 0.3;
     spec.graspable = true;

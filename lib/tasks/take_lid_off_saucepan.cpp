@@ -23,12 +23,11 @@ class TakeLidOffSaucepan : public Task {
   std::string description(int) const override { return "take lid off the saucepan"; }
 
   void build(world::World& world, int, std::mt19937_64& rng) override {
-    auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
     const double table = world.layout().table_height_m;
     // The pan: floor, wall and handle, its origin at the centre of its bottom.
     Eigen::Isometry3d pan = Eigen::Isometry3d::Identity();
-    pan.linear() = Eigen::AngleAxisd(uniform(-M_PI, M_PI), Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    pan.translation() << uniform(0.05, 0.25), uniform(-0.15, 0.15), table;
+    pan.linear() = Eigen::AngleAxisd(uniform(rng, -M_PI, M_PI), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    pan.translation() << uniform(rng, 0.05, 0.25), uniform(rng, -0.15, 0.15), table;
     std::vector<Piece> pieces = tube(16, kPanRadius, kPanRadius - kWall, 0, kPanHeight);
     pieces.push_back(frustum(16, kPanRadius, kPanRadius, 0, kFloor));
     pieces.push_back(box_piece({kPanRadius - 0.002, -0.012, kPanHeight - 0.02}, {kPanRadius + 0.12, 0.012, kPanHeight - 0.005}));

@@ -29,7 +29,6 @@ class TakeUmbrellaOutOfUmbrellaStand : public Task {
   std::string description(int) const override { return "take umbrella out of umbrella stand"; }
 
   void build(world::World& world, int, std::mt19937_64& rng) override {
-    auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
     // Within the arm's reach of the lifted handle (45 cm over the table), not the region's far
     // corners; and 12 cm from under the gripper's ready pose, which the handle would reach.
     Eigen::Vector3d ready = world.tcp_pose().translation();
@@ -42,7 +41,7 @@ class TakeUmbrellaOutOfUmbrellaStand : public Task {
     world.add_object(solid("umbrella_stand", std::move(pieces), stand, {0.2f, 0.25f, 0.45f}));
 
     Eigen::Isometry3d pose = stand;  // standing on the stand's floor, turned at random
-    pose.linear() = Eigen::AngleAxisd(uniform(-M_PI, M_PI), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    pose.linear() = Eigen::AngleAxisd(uniform(rng, -M_PI, M_PI), Eigen::Vector3d::UnitZ()).toRotationMatrix();
     pose.translation().z() += kStandFloor + 2 * world::kHullMargin;
     world::ObjectSpec spec = solid("umbrella", umbrella(), pose, {0.55f, 0.1f, 0.15f});
     spec.mass_kg = 0.3;
