@@ -33,9 +33,10 @@ std::vector<Waypoint> grasp_at(const Eigen::Vector3d& centre, double yaw_rad, do
 std::vector<Waypoint> grasp_and_lift(const world::World& world, int block_id, double lift_m) {
   const Eigen::Isometry3d pose = world.object_pose(block_id);
   // Fingers close across two opposite faces: the block's yaw modulo a quarter turn.
-  const Eigen::Vector3d x_axis = pose.linear().col(0);
-  return grasp_at(pose.translation(), std::remainder(std::atan2(x_axis.y(), x_axis.x()), M_PI / 2), lift_m);
+  return grasp_at(pose.translation(), std::remainder(yaw_of(pose), M_PI / 2), lift_m);
 }
+
+double yaw_of(const Eigen::Isometry3d& pose) { return std::atan2(pose.linear()(1, 0), pose.linear()(0, 0)); }
 
 Eigen::Vector3d grasp_point(const world::World& world, int object_id) {
   const Eigen::AlignedBox3d& region = world.object_spec(object_id).grasp_region;

@@ -18,6 +18,8 @@ world::ObjectSpec block(const world::World& world, const std::string& name, cons
 std::vector<Waypoint> grasp_at(const Eigen::Vector3d& centre, double yaw_rad, double lift_m);
 // grasp_at the block's centre, square to its faces.
 std::vector<Waypoint> grasp_and_lift(const world::World& world, int block_id, double lift_m);
+// The yaw of a pose's x axis about world z.
+double yaw_of(const Eigen::Isometry3d& pose);
 // Where the fingers close on an object (world frame): its grasp region's centre, or its origin.
 Eigen::Vector3d grasp_point(const world::World& world, int object_id);
 

@@ -94,8 +94,7 @@ class PutRubbishInBin : public Task {
 
   std::vector<Waypoint> expert_waypoints(const world::World& world) const override {
     const Eigen::Isometry3d rubbish = world.object_pose(world.object_id("rubbish"));
-    const Eigen::Vector3d x_axis = rubbish.linear().col(0);
-    auto waypoints = grasp_at(rubbish.translation(), std::atan2(x_axis.y(), x_axis.x()), 0.15);
+    auto waypoints = grasp_at(rubbish.translation(), yaw_of(rubbish), 0.15);
     Waypoint over_bin = waypoints.back();
     over_bin.tcp_pose.translation() = world.object_pose(world.object_id("bin")) * Eigen::Vector3d(0, 0, kBinSize.z() + 0.1);
     over_bin.ignore_collisions = false;

@@ -68,9 +68,8 @@ class StackWine : public Task {
   std::vector<Waypoint> expert_waypoints(const world::World& world) const override {
     const Eigen::Isometry3d bottle = world.object_pose(world.object_id("wine_bottle"));
     const Eigen::Isometry3d rack = world.object_pose(world.object_id("rack"));
-    auto yaw = [](const Eigen::Isometry3d& pose) { return std::atan2(pose.linear()(1, 0), pose.linear()(0, 0)); };
-    auto waypoints = grasp_at(bottle.translation(), yaw(bottle), 0.15);
-    const auto place = place_at(rack * Eigen::Vector3d(0, 0, kPlate + lying_height()), yaw(rack), 0.12);
+    auto waypoints = grasp_at(bottle.translation(), yaw_of(bottle), 0.15);
+    const auto place = place_at(rack * Eigen::Vector3d(0, 0, kPlate + lying_height()), yaw_of(rack), 0.12);
     waypoints.insert(waypoints.end(), place.begin(), place.end() - 1);  // no retreat: placed is done
     return waypoints;
   }

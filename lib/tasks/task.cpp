@@ -1,32 +1,46 @@
 #include "tasks/task.hpp"
 
 #include <algorithm>
+#include <utility>
 
 #include "common/error.hpp"
 #include "tasks/catalogue.hpp"
 
 namespace qte::tasks {
 
+namespace {
+
+// Every task by name, in the order usage texts list them: the one place a task is registered.
+const std::vector<std::pair<std::string, std::unique_ptr<Task> (*)()>>& registry() {
+  static const std::vector<std::pair<std::string, std::unique_ptr<Task> (*)()>> tasks = {
+      {"reach_target", make_reach_target},
+      {"pick_and_lift", make_pick_and_lift},
+      {"lift_numbered_block", make_lift_numbered_block},
+      {"reach_prism", make_reach_prism},
+      {"pick_and_lift_small", make_pick_and_lift_small},
+      {"stack_blocks", make_stack_blocks},
+      {"setup_checkers", make_setup_checkers},
+      {"take_lid_off_saucepan", make_take_lid_off_saucepan},
+      {"pick_up_cup", make_pick_up_cup},
+      {"put_rubbish_in_bin", make_put_rubbish_in_bin},
+      {"stack_wine", make_stack_wine},
+      {"phone_on_base", make_phone_on_base},
+      {"take_umbrella_out_of_umbrella_stand", make_take_umbrella_out_of_umbrella_stand},
+  };
+  return tasks;
+}
+
+}  // namespace
+
 std::vector<std::string> task_names() {
-  return {"reach_target", "pick_and_lift", "lift_numbered_block", "reach_prism", "pick_and_lift_small",
-          "stack_blocks", "setup_checkers", "take_lid_off_saucepan", "pick_up_cup", "put_rubbish_in_bin",
-          "stack_wine", "phone_on_base", "take_umbrella_out_of_umbrella_stand"};
+  std::vector<std::string> names;
+  for (const auto& [name, make] : registry()) names.push_back(name);
+  return names;
 }
 
 std::unique_ptr<Task> make_task(const std::string& name) {
-  if (name == "reach_target") return make_reach_target();
-  if (name == "pick_and_lift") return make_pick_and_lift();
-  if (name == "lift_numbered_block") return make_lift_numbered_block();
-  if (name == "reach_prism") return make_reach_prism();
-  if (name == "pick_and_lift_small") return make_pick_and_lift_small();
-  if (name == "stack_blocks") return make_stack_blocks();
-  if (name == "setup_checkers") return make_setup_checkers();
-  if (name == "take_lid_off_saucepan") return make_take_lid_off_saucepan();
-  if (name == "pick_up_cup") return make_pick_up_cup();
-  if (name == "put_rubbish_in_bin") return make_put_rubbish_in_bin();
-  if (name == "stack_wine") return make_stack_wine();
-  if (name == "phone_on_base") return make_phone_on_base();
-  if (name == "take_umbrella_out_of_umbrella_stand") return make_take_umbrella_out_of_umbrella_stand();
+  for (const auto& [known, make] : registry())
+    if (known == name) return make();
   throw Error("unknown task '" + name + "' (known tasks: " + task_list() + ")");
 }
 

@@ -12,7 +12,6 @@ namespace {
 
 using test_support::TaskScene;
 
-double yaw_of(const Eigen::Isometry3d& pose) { return std::atan2(pose.linear()(1, 0), pose.linear()(0, 0)); }
 
 // Carries out the expert's poses with the teleported arm: the gripper closes where a pose
 // says closed and opens (and physics settles) where it says open; true if the task succeeds.
@@ -148,15 +147,15 @@ TEST(PutRubbishInBin, TheRubbishInTheBinNotATomatoAndNotBesideIt) {
 TEST(StackWine, TheBottleLyingInTheSlotLetGo) {
   auto slot = [](TaskScene& scene) -> Eigen::Vector3d { return scene.pose("rack") * Eigen::Vector3d(0, 0, 0.01 + 0.036 * std::cos(M_PI / 16)); };
   TaskScene scene("stack_wine", 5, 0);
-  const double grasp_yaw = yaw_of(scene.pose("wine_bottle"));
-  scene.place("wine_bottle", grasp_yaw, slot(scene), yaw_of(scene.pose("rack")), /*release=*/false);
+  const double grasp_yaw = tasks::yaw_of(scene.pose("wine_bottle"));
+  scene.place("wine_bottle", grasp_yaw, slot(scene), tasks::yaw_of(scene.pose("rack")), /*release=*/false);
   EXPECT_FALSE(scene.task->success(scene.world));  // in the slot, still held
   scene.world.open_gripper();
   scene.world.settle(0.5);
   EXPECT_TRUE(scene.task->success(scene.world));
 
   TaskScene across("stack_wine", 5, 0);  // square to the slot: it lies on the rails
-  across.place("wine_bottle", grasp_yaw, slot(across) + Eigen::Vector3d(0, 0, 0.04), yaw_of(across.pose("rack")) + M_PI / 2);
+  across.place("wine_bottle", grasp_yaw, slot(across) + Eigen::Vector3d(0, 0, 0.04), tasks::yaw_of(across.pose("rack")) + M_PI / 2);
   EXPECT_FALSE(across.task->success(across.world));
   TaskScene table("stack_wine", 5, 0);
   table.place("wine_bottle", grasp_yaw, table.pose("wine_bottle").translation() + Eigen::Vector3d(0.05, 0, 0), grasp_yaw);
@@ -169,7 +168,7 @@ TEST(PhoneOnBase, ThePhoneOnTheBaseNothingHeld) {
   TaskScene scene("phone_on_base", 6, 0);
   // Fingers closing along the phone's length: 14 cm does not fit the 85 mm stroke.
   Eigen::Isometry3d along = Eigen::Isometry3d::Identity();
-  along.linear() = tasks::top_down(yaw_of(scene.pose("phone")));
+  along.linear() = tasks::top_down(tasks::yaw_of(scene.pose("phone")));
   along.translation() = scene.pose("phone").translation();
   scene.world.set_robot_state(test_support::ik_world(scene.world, along), 0.085);
   EXPECT_EQ(scene.world.close_gripper(), -1);
