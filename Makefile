@@ -56,8 +56,9 @@ sanitize: deps
 	ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ctest --test-dir $(BUILD)-asan --output-on-failure -j $(JOBS) -LE 'slow|slurm'
 
-# libFuzzer for FUZZ_SECONDS per target (clang from debian-packages.txt): the stream decoder,
-# then each record type's readers (tests/fuzz/fuzz_<target>.cpp, seeds in tests/fuzz/corpus/<target>/).
+# libFuzzer for FUZZ_SECONDS of CPU time per target (clang from debian-packages.txt): the stream
+# decoder, then each record type's readers (tests/fuzz/fuzz_<target>.cpp, seeds in
+# tests/fuzz/corpus/<target>/). A finding is written to tests/fuzz/findings/ and fails the target.
 FUZZ_TARGETS ?= stream_reader obs action trajectory transition checkpoint
 fuzz: deps
 	cmake -S . -B $(BUILD)-fuzz -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
@@ -66,7 +67,7 @@ fuzz: deps
 	mkdir -p tests/fuzz/findings
 	for t in $(FUZZ_TARGETS); do \
 	  mkdir -p $(BUILD)-fuzz/corpus/$$t; \
-	  $(BUILD)-fuzz/tests/fuzz/fuzz_$$t -max_total_time=$(FUZZ_SECONDS) -rss_limit_mb=4096 \
+	  tests/fuzz/run_for_cpu.sh $(FUZZ_SECONDS) $(BUILD)-fuzz/tests/fuzz/fuzz_$$t -rss_limit_mb=4096 \
 	    -artifact_prefix=tests/fuzz/findings/$$t- -print_final_stats=1 \
 	    $(BUILD)-fuzz/corpus/$$t tests/fuzz/corpus/$$t || exit 1; \
 	done

@@ -1,6 +1,7 @@
 // plan-path: next-best poses to collision-free joint trajectories on the sensed scene.
 #include "cli/command.hpp"
 #include "planning/motion_planner.hpp"
+#include "point_clouds/cloud_filters.hpp"
 #include "world/scene_layout.hpp"
 #include "stream/reader.hpp"
 #include "stream/writer.hpp"
@@ -40,6 +41,7 @@ static cli::Usage usage() {
       {"octomap", "FILE.bt", "write the scene map of the last planned action (opens in octovis)", ""},
       {"output", "FILE", "where to write; '-' is standard output", "-"},
   };
+  for (auto& option : point_clouds::cloud_filter_options()) u.options.push_back(option);
   u.uses_randomness = true;
   u.examples = {
       {"sim-step --task reach_target < fifo | qte-select --checkpoint ckpt/latest.rec | plan-path > fifo",
@@ -65,6 +67,9 @@ static void run(const cli::Arguments& args) {
   const robot::RobotModel robot = robot::RobotModel::xarm7();
   const Eigen::Isometry3d world_from_base = world::SceneLayout{}.robot_base_pose();
   planning::PlanPathFilter filter(robot, world_from_base, options);
+  const point_clouds::CloudFilters filters = point_clouds::parse_cloud_filters(args);
+  if (filters.any())
+    filter.observe_through([filters](const stream::Record& obs) { return point_clouds::filter_observation(obs, filters); });
   stream::RecordReader reader(args.positional().empty() ? "-" : args.positional()[0]);
   stream::RecordWriter writer(args.text("output"));
   while (auto record = reader.next())

@@ -13,6 +13,7 @@
 #include "nets/qattention_net.hpp"
 #include "qattention/acting.hpp"
 #include "qattention/action_record.hpp"
+#include "point_clouds/cloud_filters.hpp"
 #include "qattention/branching_options.hpp"
 #include "qattention/proprio.hpp"
 #include "stream/reader.hpp"
@@ -90,6 +91,7 @@ static cli::Usage usage() {
       {"output", "FILE", "where to write; '-' is standard output", "-"},
   };
   for (auto& option : qattention::branching_options()) u.options.push_back(option);
+  for (auto& option : point_clouds::cloud_filter_options()) u.options.push_back(option);
   u.uses_randomness = true;
   u.examples = {
       {"sim-step --task reach_target --episodes 10 < fifo | qte-select --checkpoint ckpt.rec | plan-path > fifo",
@@ -199,6 +201,7 @@ static void run(const cli::Arguments& args) {
   const qattention::Exploration exploration = exploration_from(args);
   const bool ignore_collisions = args.flag("ignore-collisions"), reload = args.flag("reload");
   const std::string png_dir = args.text("png");
+  const point_clouds::CloudFilters filters = point_clouds::parse_cloud_filters(args);
 
   nets::set_torch_threads(static_cast<int>(threads));
   qattention::CheckpointNetworks networks(checkpoint);
@@ -219,7 +222,8 @@ static void run(const cli::Arguments& args) {
       std::cerr << "qte-select: loaded checkpoint " << checkpoint << " at training step " << networks.step()
                 << std::endl;
     std::mt19937_64 rng(derive_seed(args.seed(), actions));
-    const voxels::ObservationCloud observed = voxels::observation_cloud(*record);
+    const voxels::ObservationCloud observed =
+        voxels::observation_cloud(filters.any() ? point_clouds::filter_observation(*record, filters) : *record);
     qattention::Action action =  // not const: its pictures compute the grids they show lazily
         act_on(*record, observed, step, evaluate, hierarchy, branching, exploration, rng, checkpoint);
     if (!png_dir.empty()) qattention::save_q_pictures(png_dir, actions, action);

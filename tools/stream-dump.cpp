@@ -6,6 +6,7 @@
 #include <set>
 
 #include "cli/command.hpp"
+#include "point_clouds/pcd_file.hpp"
 #include "stream/inspect.hpp"
 #include "stream/npy.hpp"
 #include "stream/reader.hpp"
@@ -25,6 +26,10 @@ static cli::Usage usage() {
       "With --json each record becomes one JSON object per line (JSON Lines), for jq and "
       "scripts. With --npy every array is also exported as DIR/<index>.<type>.<field>.npy "
       "(index zero-padded to 6 digits) for NumPy.",
+      "With --pcd every camera of the shown 'obs' and 'frame' records is also written as "
+      "DIR/<index>.<camera>.pcd: the world-frame point cloud (the stored points, or points "
+      "rebuilt from depth) with its colours, binary XYZRGB, organized as the image (NaN where a "
+      "pixel has no return), for pcl_viewer and other PCL programs.",
   };
   u.arguments = {{"FILE", "record streams to read in order; '-' is standard input", true, true}};
   u.options = {
@@ -33,6 +38,7 @@ static cli::Usage usage() {
       {"values", "N", "values shown per field; -1 shows all", "6"},
       {"all-values", "", "show every value (same as --values -1)", ""},
       {"npy", "DIR", "also export every field of the shown records as .npy files into DIR", ""},
+      {"pcd", "DIR", "also export every camera's point cloud of the shown observations as .pcd files into DIR", ""},
       {"summary", "", "print only a count of records and bytes per type at the end", ""},
       {"max-record-bytes", "N", "treat a record payload or decompressed field larger than N bytes as damage",
        std::to_string(uint64_t(4) << 30)},
@@ -43,6 +49,8 @@ static cli::Usage usage() {
        "field names of the observations"},
       {"sim-step --task reach_target < actions.rec | stream-dump --npy frames/",
        "export what the simulator emits as NumPy arrays"},
+      {"stream-dump --summary --pcd clouds/ episode.rec && pcl_viewer clouds/000000.front.pcd",
+       "look at the first observation's point cloud in PCL's viewer"},
   };
   u.see_also = {"qte-stream(5)", "stream-cat(1)", "stream-pack(1)"};
   return u;
@@ -61,9 +69,10 @@ static void run(const cli::Arguments& args) {
   const std::set<std::string> types(wanted.begin(), wanted.end());
   stream::InspectOptions inspect;
   inspect.max_values = args.flag("all-values") ? -1 : args.integer("values", -1, 1000000000);
-  const std::string npy_dir = args.text("npy");
-  if (!npy_dir.empty() && ::mkdir(npy_dir.c_str(), 0755) != 0 && errno != EEXIST)
-    throw_system_error("cannot create directory " + npy_dir);
+  const std::string npy_dir = args.text("npy"), pcd_dir = args.text("pcd");
+  for (const std::string& dir : {npy_dir, pcd_dir})
+    if (!dir.empty() && ::mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST)
+      throw_system_error("cannot create directory " + dir);
   stream::ReadOptions read_options;
   if (args.integer("max-record-bytes") <= 0) throw UsageError("--max-record-bytes must be positive");
   read_options.max_record_bytes = static_cast<uint64_t>(args.integer("max-record-bytes"));
@@ -79,13 +88,15 @@ static void run(const cli::Arguments& args) {
       auto& total = totals[record->type()];
       total.first += 1;
       total.second += bytes;
+      char index[16];
+      std::snprintf(index, sizeof index, "%06llu", static_cast<unsigned long long>(record->position.record_index));
+      if (!pcd_dir.empty() && (record->type() == "obs" || record->type() == "frame"))
+        for (const auto& camera : voxels::camera_clouds(*record))
+          point_clouds::write_pcd(pcd_dir + "/" + index + "." + camera.camera + ".pcd", camera);
       if (args.flag("summary")) continue;
       if (args.flag("json")) stream::print_record_json(std::cout, *record, bytes, inspect);
       else stream::print_record_text(std::cout, *record, bytes, inspect);
       if (!npy_dir.empty()) {
-        char index[16];
-        std::snprintf(index, sizeof index, "%06llu",
-                      static_cast<unsigned long long>(record->position.record_index));
         for (const auto& field : record->fields())
           stream::write_npy(npy_dir + "/" + index + "." + record->type() + "." + field.name() +
                                 ".npy",

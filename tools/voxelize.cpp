@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "cli/command.hpp"
+#include "point_clouds/cloud_filters.hpp"
 #include "stream/reader.hpp"
 #include "stream/writer.hpp"
 #include "voxels/voxel_image.hpp"
@@ -46,6 +47,7 @@ static cli::Usage usage() {
       {"png", "DIR", "save a picture of every grid as DIR/<record>.depth<d>[.<k>].png", ""},
       {"output", "FILE", "where to write; '-' is standard output", "-"},
   };
+  for (auto& option : point_clouds::cloud_filter_options()) u.options.push_back(option);
   u.examples = {
       {"sim-step --task reach_target < /dev/null | voxelize --png grids/ | stream-dump --type voxels",
        "voxelize the first observation and look at it"},
@@ -56,32 +58,17 @@ static cli::Usage usage() {
   return u;
 }
 
-static std::vector<double> numbers(const std::string& option, const std::string& text, std::size_t count) {
-  std::vector<double> v;
-  std::stringstream in(text);
-  for (std::string item; std::getline(in, item, ',');) {
-    try {
-      std::size_t used = 0;
-      v.push_back(std::stod(item, &used));
-      if (used != item.size() || !std::isfinite(v.back())) throw std::invalid_argument(item);
-    } catch (const std::exception&) {
-      throw UsageError("--" + option + ": '" + item + "' is not a finite number");
-    }
-  }
-  if (v.size() != count) throw UsageError("--" + option + ": expected " + std::to_string(count) + " comma-separated numbers");
-  return v;
-}
-
 static void run(const cli::Arguments& args) {
   const voxels::GridBounds scene = voxels::GridBounds::parse(args.text("bounds"), static_cast<int>(args.integer("voxels", 2, 256)));
   if (scene.voxels > 256) throw UsageError("--voxels must be 2-256");
   const double offset = args.real("offset", 0.001, 10);
   std::vector<voxels::GridBounds> crops;
   for (const auto& c : args.all("centre")) {
-    const auto p = numbers("centre", c, 3);
+    const auto p = cli::parse_reals("centre", c, 3);
     crops.push_back(voxels::GridBounds::around({p[0], p[1], p[2]}, offset, scene.voxels));
   }
   const bool octomap_channels = args.flag("octomap-channels");
+  const point_clouds::CloudFilters filters = point_clouds::parse_cloud_filters(args);
   const std::string png_dir = args.text("png");
   if (!png_dir.empty() && ::mkdir(png_dir.c_str(), 0755) != 0 && errno != EEXIST)
     throw_system_error("cannot create directory " + png_dir);
@@ -92,7 +79,8 @@ static void run(const cli::Arguments& args) {
   while (auto record = reader.next()) {
     writer.write(*record);
     if (record->type() != "obs") continue;
-    const voxels::VoxelsOfObservation out = voxels::voxels_of(*record, {scene, crops, octomap_channels});
+    const voxels::VoxelsOfObservation out = voxels::voxels_of(
+        filters.any() ? point_clouds::filter_observation(*record, filters) : *record, {scene, crops, octomap_channels});
     if (!png_dir.empty()) {
       char index[16];
       std::snprintf(index, sizeof index, "%06llu", static_cast<unsigned long long>(record->position.record_index));

@@ -160,6 +160,27 @@ double Arguments::real(const std::string& name, double lo, double hi) const {
   return x;
 }
 
+std::vector<double> Arguments::reals(const std::string& name, std::size_t count) const {
+  return parse_reals(name, text(name), count);
+}
+
+std::vector<double> parse_reals(const std::string& option, const std::string& text, std::size_t count) {
+  std::vector<double> v;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, ',');) {
+    try {
+      std::size_t used = 0;
+      v.push_back(std::stod(item, &used));
+      if (used != item.size() || !std::isfinite(v.back())) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw UsageError("--" + option + ": '" + item + "' is not a finite number");
+    }
+  }
+  if (v.size() != count)
+    throw UsageError("--" + option + ": expected " + std::to_string(count) + " comma-separated numbers");
+  return v;
+}
+
 std::vector<std::string> Arguments::all(const std::string& name) const {
   auto it = given_.find(name);
   return it == given_.end() ? std::vector<std::string>{} : it->second;

@@ -55,6 +55,8 @@ class Arguments {
   double real(const std::string& name) const;
   // The same, refused with a UsageError unless finite and within lo..hi.
   double real(const std::string& name, double lo, double hi) const;
+  // Exactly `count` comma-separated finite numbers ("0.1,0,0.8"), or a UsageError naming the option.
+  std::vector<double> reals(const std::string& name, std::size_t count) const;
   std::vector<std::string> all(const std::string& name) const;  // repeatable options
   const std::vector<std::string>& positional() const { return positional_; }
   uint64_t seed() const { return static_cast<uint64_t>(integer("seed")); }
@@ -65,6 +67,9 @@ class Arguments {
   std::map<std::string, std::vector<std::string>> given_;
   std::vector<std::string> positional_;
 };
+
+// The list parser behind Arguments::reals, for values of repeatable options.
+std::vector<double> parse_reals(const std::string& option, const std::string& text, std::size_t count);
 
 // Throws UsageError on unknown options, missing values or wrong argument counts.
 Arguments parse(const Usage& usage, const std::vector<std::string>& argv);

@@ -283,7 +283,7 @@ void PlanPathFilter::handle(const stream::Record& record,
                             const std::function<void(const stream::Record&)>& emit) {
   emit(record);
   if (record.type() == "obs") {
-    obs_ = record;
+    obs_ = prepare_ ? prepare_(record) : record;
     scene_.reset();
     return;
   }

@@ -107,12 +107,16 @@ class PlanPathFilter {
  public:
   PlanPathFilter(const robot::RobotModel& robot, const Eigen::Isometry3d& world_from_base, PlannerOptions options);
   void handle(const stream::Record& record, const std::function<void(const stream::Record&)>& emit);
+  // Plans on what `prepare` makes of each observation (point-cloud filters) instead of the
+  // observation itself; records still pass through unchanged.
+  void observe_through(std::function<stream::Record(const stream::Record&)> prepare) { prepare_ = std::move(prepare); }
   const OccupancyScene* last_scene() const { return scene_.get(); }
   uint64_t plans() const { return plans_; }
 
  private:
   MotionPlanner planner_;
   std::optional<stream::Record> obs_;
+  std::function<stream::Record(const stream::Record&)> prepare_;
   std::unique_ptr<OccupancyScene> scene_;  // of obs_ and the last action
   uint64_t plans_ = 0;
 };

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
+#include <tuple>
 
 namespace qte::voxels {
 
@@ -28,43 +29,69 @@ void points_from_depth(const float* depth_m, int width, int height, const double
     }
 }
 
+namespace {
+
+// Appends one camera's pixels to xyz/rgb: its stored points, or points rebuilt from its depth.
+// Returns the image's (height, width).
+std::pair<int, int> append_camera(const stream::Record& obs, const std::string& camera, std::vector<float>& xyz,
+                                  std::vector<uint8_t>& rgb_out) {
+  const std::string name = camera + ".rgb";
+  const auto rgb = obs.array<uint8_t>(name);
+  if (rgb.shape.size() != 3 || rgb.shape[2] != 3) obs.fail(name, "uint8 [H, W, 3]");
+  const int h = static_cast<int>(rgb.shape[0]), w = static_cast<int>(rgb.shape[1]);
+  const std::size_t n = static_cast<std::size_t>(h) * w, at = rgb_out.size() / 3;
+  rgb_out.insert(rgb_out.end(), rgb.begin(), rgb.end());
+  xyz.resize(3 * (at + n));
+  float* out = xyz.data() + 3 * at;
+  if (obs.has(camera + ".points")) {
+    const auto points = obs.array<float>(camera + ".points");
+    if (points.shape != stream::Shape{h, w, 3}) obs.fail(camera + ".points", "float32 [H, W, 3] like " + name);
+    std::copy(points.begin(), points.end(), out);
+    return {h, w};
+  }
+  std::vector<float> depth(n);
+  if (obs.has(camera + ".depth_mm")) {
+    const auto mm = obs.array<uint16_t>(camera + ".depth_mm");
+    if (mm.shape != stream::Shape{h, w}) obs.fail(camera + ".depth_mm", "uint16 [H, W] like " + name);
+    for (std::size_t i = 0; i < n; ++i) depth[i] = mm[i] * 0.001f;
+  } else {
+    const auto d = obs.array<float>(camera + ".depth");
+    if (d.shape != stream::Shape{h, w}) obs.fail(camera + ".depth", "float32 [H, W] like " + name);
+    std::copy(d.begin(), d.end(), depth.begin());
+  }
+  const auto k = obs.array<double>(camera + ".intrinsics");
+  const auto e = obs.array<double>(camera + ".extrinsics");
+  if (k.size() != 9) obs.fail(camera + ".intrinsics", "float64 [3, 3]");
+  if (e.size() != 16) obs.fail(camera + ".extrinsics", "float64 [4, 4]");
+  points_from_depth(depth.data(), w, h, k.data, e.data, out);
+  return {h, w};
+}
+
+[[noreturn]] void no_camera(const stream::Record& obs) {
+  throw StreamError(obs.position, "'" + obs.type() + "' record has no camera image (<camera>.rgb with "
+                                  "<camera>.points or <camera>.depth): nothing to voxelize");
+}
+
+}  // namespace
+
 ObservationCloud observation_cloud(const stream::Record& obs) {
   ObservationCloud cloud;
-  for (const std::string& camera : obs.prefixes(".rgb")) {
-    const std::string name = camera + ".rgb";
-    const auto rgb = obs.array<uint8_t>(name);
-    if (rgb.shape.size() != 3 || rgb.shape[2] != 3) obs.fail(name, "uint8 [H, W, 3]");
-    const int h = static_cast<int>(rgb.shape[0]), w = static_cast<int>(rgb.shape[1]);
-    const std::size_t n = static_cast<std::size_t>(h) * w, at = cloud.rgb.size() / 3;
-    cloud.rgb.insert(cloud.rgb.end(), rgb.begin(), rgb.end());
-    cloud.xyz.resize(3 * (at + n));
-    float* out = cloud.xyz.data() + 3 * at;
-    if (obs.has(camera + ".points")) {
-      const auto points = obs.array<float>(camera + ".points");
-      if (points.shape != stream::Shape{h, w, 3}) obs.fail(camera + ".points", "float32 [H, W, 3] like " + name);
-      std::copy(points.begin(), points.end(), out);
-      continue;
-    }
-    std::vector<float> depth(n);
-    if (obs.has(camera + ".depth_mm")) {
-      const auto mm = obs.array<uint16_t>(camera + ".depth_mm");
-      if (mm.shape != stream::Shape{h, w}) obs.fail(camera + ".depth_mm", "uint16 [H, W] like " + name);
-      for (std::size_t i = 0; i < n; ++i) depth[i] = mm[i] * 0.001f;
-    } else {
-      const auto d = obs.array<float>(camera + ".depth");
-      if (d.shape != stream::Shape{h, w}) obs.fail(camera + ".depth", "float32 [H, W] like " + name);
-      std::copy(d.begin(), d.end(), depth.begin());
-    }
-    const auto k = obs.array<double>(camera + ".intrinsics");
-    const auto e = obs.array<double>(camera + ".extrinsics");
-    if (k.size() != 9) obs.fail(camera + ".intrinsics", "float64 [3, 3]");
-    if (e.size() != 16) obs.fail(camera + ".extrinsics", "float64 [4, 4]");
-    points_from_depth(depth.data(), w, h, k.data, e.data, out);
-  }
-  if (cloud.rgb.empty())
-    throw StreamError(obs.position, "'" + obs.type() + "' record has no camera image (<camera>.rgb with "
-                                    "<camera>.points or <camera>.depth): nothing to voxelize");
+  const std::vector<std::string> cameras = obs.prefixes(".rgb");
+  if (cameras.empty()) no_camera(obs);
+  for (const std::string& camera : cameras) append_camera(obs, camera, cloud.xyz, cloud.rgb);
   return cloud;
+}
+
+std::vector<CameraCloud> camera_clouds(const stream::Record& obs) {
+  std::vector<CameraCloud> clouds;
+  for (const std::string& camera : obs.prefixes(".rgb")) {
+    CameraCloud c;
+    c.camera = camera;
+    std::tie(c.height, c.width) = append_camera(obs, camera, c.cloud.xyz, c.cloud.rgb);
+    clouds.push_back(std::move(c));
+  }
+  if (clouds.empty()) no_camera(obs);
+  return clouds;
 }
 
 }  // namespace qte::voxels

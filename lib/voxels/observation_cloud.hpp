@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "stream/record.hpp"
@@ -20,6 +21,15 @@ struct ObservationCloud {
 
 // Throws StreamError naming the record when it holds no camera with rgb and points or depth.
 ObservationCloud observation_cloud(const stream::Record& obs);
+
+// The same points one camera at a time, in the record's camera order, with the image size
+// (a camera's cloud is organized: pixel (row, col) is point row * width + col).
+struct CameraCloud {
+  std::string camera;  // "front"
+  int height = 0, width = 0;
+  ObservationCloud cloud;
+};
+std::vector<CameraCloud> camera_clouds(const stream::Record& obs);
 
 // World points of a depth image (metres along the optical axis, 0 = none -> NaN).
 void points_from_depth(const float* depth_m, int width, int height, const double* intrinsics_3x3,
