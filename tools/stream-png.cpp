@@ -1,78 +1,145 @@
-// stream-png: save the camera images of a stream as PNG files a person can look at.
+// stream-png: save the camera images of a stream as PNG files, or an episode as a video.
 #include <sys/stat.h>
 
 #include <cstdio>
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "cli/command.hpp"
 #include "render/camera.hpp"
 #include "stream/reader.hpp"
+#include "video/video_file.hpp"
+#include "voxels/observation_cloud.hpp"
 
 using namespace qte;
 
 static cli::Usage usage() {
   cli::Usage u;
   u.name = "stream-png";
-  u.summary = "save the images of a record stream as PNG files";
+  u.summary = "save the images of a record stream as PNG files, or as a video";
   u.description = {
       "Reads record streams and writes every image field as a PNG into DIR: uint8 fields of "
       "shape [H, W, 3] named *.rgb as colour images, and with --depth float32 [H, W] fields "
-      "named *.depth as colour-mapped depth (near warm, far cool, no return black). Files are "
-      "named <record index>.<field>.png (index zero-padded to 6 digits) and written atomically.",
+      "named *.depth as colour-mapped depth (near warm, far cool, no return black). With "
+      "--depth-mm depth is also saved as a 16-bit PNG in millimetres (0 = no return), the form "
+      "depth cameras save and obs-pack reads. Files are named <record index>.<field>.png (index "
+      "zero-padded to 6 digits) and written atomically.",
+      "With --video FILE.mp4 (or FILE.gif, an animated GIF for web pages) the camera's images "
+      "become the frames of one video instead, at --fps. With --attention DIR, the pictures "
+      "qte-select --png DIR saved for the action chosen on each observation (DIR/<n>.depth<d>.png, "
+      "n counting the non-terminal observations from 0, as qte-select counts its actions) are "
+      "shown beside the camera; an observation without an action (the last) shows black there.",
   };
   u.arguments = {{"FILE", "record streams; '-' or absent is standard input", true, true}};
   u.options = {
       {"dir", "DIR", "where the PNG files go (created if missing)", "."},
       {"type", "T", "only records of type T", "obs"},
       {"depth", "", "also save depth images", ""},
+      {"depth-mm", "", "also save depth as 16-bit PNGs in millimetres", ""},
       {"every", "N", "only every N-th record of the type", "1"},
+      {"video", "FILE", "write the frames as one video, FILE.mp4 or FILE.gif, instead of PNG files", ""},
+      {"fps", "F", "video frames per second", "2"},
+      {"camera", "NAME", "the camera a video shows", "front"},
+      {"attention", "DIR", "show qte-select's pictures from DIR beside each video frame", ""},
+      {"height", "PX", "video frame height; every panel is scaled to it", "256"},
   };
   u.examples = {
       {"sim-step --task lift_numbered_block --image-size 256x256 < /dev/null | stream-png --dir frames/",
        "look at the first observation of an episode"},
       {"stream-png --depth --every 10 --dir demo_frames demos.rec", "every 10th frame of saved demos"},
+      {"sim-step --task pick_and_lift < fifo | qte-select --checkpoint ckpt.rec --png q/ | tee ep.rec | plan-path > fifo; "
+       "stream-png --video ep.mp4 --attention q/ ep.rec",
+       "an episode of the agent, with what it attended to at each step"},
   };
-  u.see_also = {"sim-step(1)", "stream-dump(1)", "qte-stream(5)"};
+  u.see_also = {"sim-step(1)", "qte-select(1)", "obs-pack(1)", "stream-dump(1)", "qte-stream(5)"};
   return u;
 }
+
+namespace {
+
+// An image field that is not one, or empty, is the input's fault: name the record.
+cv::Mat image_of(const stream::Record& record, const stream::Field& field, bool depth) {
+  const auto& shape = field.shape();
+  if (!depth && !(field.dtype() == stream::DType::u8 && shape.size() == 3 && shape[2] == 3))
+    record.fail(field.name(), "an RGB image (uint8, height x width x 3)");
+  if (depth && !(field.dtype() == stream::DType::f32 && shape.size() == 2))
+    record.fail(field.name(), "a depth image (float32, height x width)");
+  if (shape[0] == 0 || shape[1] == 0) record.fail(field.name(), "a non-empty image");
+  return cv::Mat(static_cast<int>(shape[0]), static_cast<int>(shape[1]), depth ? CV_32FC1 : CV_8UC3,
+                 const_cast<uint8_t*>(field.bytes()));
+}
+
+void save_pngs(const stream::Record& record, const std::string& dir, bool depth, bool depth_mm) {
+  char index[16];
+  std::snprintf(index, sizeof index, "%06llu", static_cast<unsigned long long>(record.position.record_index));
+  for (const auto& field : record.fields()) {
+    const std::string path = dir + "/" + index + "." + field.name();
+    if (stream::ends_with(field.name(), ".rgb")) render::save_rgb_png(path + ".png", image_of(record, field, false));
+    if (!stream::ends_with(field.name(), ".depth") || !(depth || depth_mm)) continue;
+    const cv::Mat metres = image_of(record, field, true);
+    if (depth) render::save_depth_png(path + ".png", metres);
+    if (depth_mm) {
+      const std::vector<uint16_t> mm = voxels::depth_in_mm(metres.ptr<float>(), metres.total());
+      render::save_mm_png(path + "_mm.png", cv::Mat(metres.rows, metres.cols, CV_16UC1, const_cast<uint16_t*>(mm.data())));
+    }
+  }
+}
+
+// The pictures qte-select saved for action n, or black panels of their size once they ran out.
+std::vector<cv::Mat> attention_pictures(const std::string& dir, int64_t action, std::vector<cv::Size>& sizes) {
+  std::vector<cv::Mat> pictures;
+  for (int d = 0;; ++d) {
+    char name[64];
+    std::snprintf(name, sizeof name, "/%06lld.depth%d.png", static_cast<long long>(action), d);
+    struct stat st;
+    if (action < 0 || ::stat((dir + name).c_str(), &st) != 0) break;  // no such picture (OpenCV would warn)
+    cv::Mat bgr = cv::imread(dir + name, cv::IMREAD_COLOR);
+    if (bgr.empty()) throw Error(dir + name + ": not a readable picture");
+    cv::cvtColor(bgr, bgr, cv::COLOR_BGR2RGB);
+    pictures.push_back(bgr);
+  }
+  if (!pictures.empty()) sizes.clear();
+  for (const cv::Mat& p : pictures) sizes.push_back(p.size());
+  if (pictures.empty())
+    for (const cv::Size& s : sizes) pictures.emplace_back(s, CV_8UC3, cv::Scalar(0, 0, 0));
+  return pictures;
+}
+
+}  // namespace
 
 static void run(const cli::Arguments& args) {
   std::vector<std::string> files = args.positional();
   if (files.empty()) files.push_back("-");
-  const std::string dir = args.text("dir"), type = args.text("type");
+  const std::string dir = args.text("dir"), type = args.text("type"), camera = args.text("camera") + ".rgb";
+  const std::string attention = args.text("attention");
   const int64_t every = args.integer("every", 1, 1000000000);
-  if (every < 1) throw UsageError("--every must be at least 1");
-  if (::mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) throw_system_error("cannot create directory " + dir);
-  int64_t seen = 0;
+  const int height = static_cast<int>(args.integer("height", 16, 4096));
+  std::unique_ptr<video::VideoFile> video;
+  if (args.has("video")) video = std::make_unique<video::VideoFile>(args.text("video"), args.real("fps", 0.01, 1000));
+  else if (::mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) throw_system_error("cannot create directory " + dir);
+  if (!attention.empty() && !video) throw UsageError("--attention goes with --video");
+  int64_t seen = 0, actions = 0;
+  std::vector<cv::Size> picture_sizes;
   for (const auto& file : files) {
     stream::RecordReader reader(file);
     while (auto record = reader.next()) {
-      if (record->type() != type || seen++ % every != 0) continue;
-      char index[16];
-      std::snprintf(index, sizeof index, "%06llu", static_cast<unsigned long long>(record->position.record_index));
-      for (const auto& field : record->fields()) {
-        const auto& shape = field.shape();
-        const std::string path = dir + "/" + index + "." + field.name() + ".png";
-        const bool rgb = stream::ends_with(field.name(), ".rgb");
-        const bool depth = args.flag("depth") && stream::ends_with(field.name(), ".depth");
-        // An image field that is not one, or empty, is the input's fault: name the record.
-        if (rgb && !(field.dtype() == stream::DType::u8 && shape.size() == 3 && shape[2] == 3))
-          record->fail(field.name(), "an RGB image (uint8, height x width x 3)");
-        if (depth && !(field.dtype() == stream::DType::f32 && shape.size() == 2))
-          record->fail(field.name(), "a depth image (float32, height x width)");
-        if ((rgb || depth) && (shape[0] == 0 || shape[1] == 0)) record->fail(field.name(), "a non-empty image");
-        if (rgb) {
-          const cv::Mat rgb(static_cast<int>(shape[0]), static_cast<int>(shape[1]), CV_8UC3,
-                            const_cast<uint8_t*>(field.bytes()));
-          render::save_rgb_png(path, rgb);
-        } else if (depth) {
-          const cv::Mat depth(static_cast<int>(shape[0]), static_cast<int>(shape[1]), CV_32FC1,
-                              const_cast<uint8_t*>(field.bytes()));
-          render::save_depth_png(path, depth);
-        }
+      if (record->type() != type) continue;
+      // qte-select acts on every non-terminal observation: that is its action index.
+      const bool acted = type == "obs" && !(record->has("terminal") && record->scalar<uint8_t>("terminal") != 0);
+      const int64_t action = acted ? actions++ : -1;
+      if (seen++ % every != 0) continue;
+      if (!video) {
+        save_pngs(*record, dir, args.flag("depth"), args.flag("depth-mm"));
+        continue;
       }
+      const cv::Mat frame = image_of(*record, record->field(camera), false);
+      const std::vector<cv::Mat> pictures =
+          attention.empty() ? std::vector<cv::Mat>{} : attention_pictures(attention, action, picture_sizes);
+      video->add(video::side_by_side(frame, pictures, height));
     }
   }
+  if (video) video->close();
 }
 
 int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }

@@ -7,6 +7,7 @@
 #include "keyframes/keyframes.hpp"
 #include "tasks/episode.hpp"
 #include "voxels/grid_fields.hpp"
+#include "voxels/observation_cloud.hpp"
 
 namespace qte::keyframes {
 namespace {
@@ -140,10 +141,7 @@ stream::Record frame_record(const stream::Record& obs, int64_t episode_key) {
     } else if (stream::ends_with(name, ".depth")) {
       // Millimetres in 16 bits: 0.5 mm rounding, far below a 1.9 cm voxel, half the bytes.
       const auto depth = obs.array<float>(name);
-      std::vector<uint16_t> mm(static_cast<std::size_t>(depth.size()));
-      for (std::size_t i = 0; i < mm.size(); ++i)
-        mm[i] = static_cast<uint16_t>(std::clamp(std::lround(depth[static_cast<int64_t>(i)] * 1000.0), 0L, 65535L));
-      frame.set<uint16_t>(name + "_mm", depth.shape, mm, /*compress=*/true);
+      frame.set<uint16_t>(name + "_mm", depth.shape, voxels::depth_in_mm(depth.data, depth.size()), /*compress=*/true);
     } else if (stream::ends_with(name, ".intrinsics") || stream::ends_with(name, ".extrinsics")) {
       frame.add(field);
     }

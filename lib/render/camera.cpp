@@ -211,6 +211,14 @@ void save_rgb_png(const std::string& path, const cv::Mat& rgb) {
   write_file_atomically(path, png.data(), png.size());
 }
 
+void save_mm_png(const std::string& path, const cv::Mat& millimetres) {
+  if (millimetres.empty() || millimetres.type() != CV_16UC1)
+    throw Error("save_mm_png: " + path + ": need a 16-bit depth image (CV_16UC1)");
+  std::vector<uchar> png;
+  if (!cv::imencode(".png", millimetres, png)) throw Error("cannot encode " + path + " as PNG");
+  write_file_atomically(path, png.data(), png.size());
+}
+
 void save_depth_png(const std::string& path, const cv::Mat& depth) {
   if (depth.empty() || depth.type() != CV_32FC1)
     throw Error("save_depth_png: " + path + ": need a float depth image (CV_32FC1)");

@@ -73,5 +73,7 @@ CameraFrame render(const btCollisionWorld& world, const CameraIntrinsics& intrin
 // colour map (near warm, far cool; no-return black).
 void save_rgb_png(const std::string& path, const cv::Mat& rgb);
 void save_depth_png(const std::string& path, const cv::Mat& depth);
+// Depth as depth cameras save it: 16-bit millimetres, 0 = no return (CV_16UC1).
+void save_mm_png(const std::string& path, const cv::Mat& millimetres);
 
 }  // namespace qte::render

@@ -1,11 +1,19 @@
 #include "voxels/observation_cloud.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <tuple>
 
 namespace qte::voxels {
+
+std::vector<uint16_t> depth_in_mm(const float* depth_m, std::size_t count) {
+  std::vector<uint16_t> mm(count);
+  for (std::size_t i = 0; i < count; ++i)
+    mm[i] = static_cast<uint16_t>(std::clamp(std::lround(depth_m[i] * 1000.0), 0L, 65535L));
+  return mm;
+}
 
 void points_from_depth(const float* depth_m, int width, int height, const double* k, const double* e,
                        float* xyz_out) {

@@ -31,6 +31,10 @@ struct CameraCloud {
 };
 std::vector<CameraCloud> camera_clouds(const stream::Record& obs);
 
+// Depth in metres as uint16 millimetres (the replay's and depth cameras' form): rounded to the
+// nearest, 0 (no return) stays 0, beyond 65.535 m saturates.
+std::vector<uint16_t> depth_in_mm(const float* depth_m, std::size_t count);
+
 // World points of a depth image (metres along the optical axis, 0 = none -> NaN).
 void points_from_depth(const float* depth_m, int width, int height, const double* intrinsics_3x3,
                        const double* extrinsics_4x4, float* xyz_out);

@@ -164,6 +164,25 @@ first_obs | qte-select --checkpoint "$ckpt" --ignore-collisions --png "$tmp/png"
   || fail "--ignore-collisions"
 [ -s "$tmp/png/000000.depth0.png" ] && [ -s "$tmp/png/000000.depth1.png" ] || fail "--png wrote no pictures"
 
+# An episode video with the attention pictures of each action beside the camera (stream-png
+# --video): one frame per observation, the camera and two 256-pixel panels wide. MP4's sample
+# table and sample entry read here; the decoders' read-back is in tests/unit/video.
+qte-select --checkpoint "$ckpt" --png "$tmp/attention" "$tmp/episodes.rec" > /dev/null || fail "qte-select --png on episodes"
+stream-png --video "$tmp/episodes.mp4" --fps 4 --attention "$tmp/attention" "$tmp/episodes.rec" || fail "stream-png --video"
+stream-png --video "$tmp/episodes.gif" --height 64 "$tmp/episodes.rec" || fail "stream-png --video .gif"
+observations=$(stream-dump --summary --type obs "$tmp/episodes.rec" | cut -f2 | cut -d' ' -f1)
+$py - "$tmp/episodes.mp4" "$tmp/episodes.gif" "$observations" <<'EOF2' || fail "episode video"
+import struct, sys
+mp4 = open(sys.argv[1], "rb").read()
+frames = struct.unpack(">I", mp4[mp4.index(b"stsz") + 12:][:4])[0]
+entry = mp4.index(b"mp4v")
+width, height = struct.unpack(">HH", mp4[entry + 28:entry + 32])
+assert frames == int(sys.argv[3]), f"{frames} frames for {sys.argv[3]} observations"
+assert (width, height) == (3 * 256, 256), f"frame {width}x{height}"  # 64x64 camera + two pictures
+gif = open(sys.argv[2], "rb").read()
+assert gif[:6] == b"GIF89a" and struct.unpack("<HH", gif[6:10]) == (64, 64), "GIF header"
+EOF2
+
 # --reload: the checkpoint replaced between two episodes is loaded at the second one's start.
 qattn-train --steps 0 --seed 2 --checkpoint-dir "$tmp/ckpt2" "$tmp/transitions.rec" 2>/dev/null || fail "qattn-train --seed 2"
 cp "$ckpt" "$tmp/live.rec"

@@ -1,0 +1,59 @@
+// Saved camera frames made into 'obs' records (formats/record-stream.md), so the learned agent
+// runs on a real RGB-D camera's data: a colour PNG with a 16-bit depth PNG, or a .pcd cloud, plus
+// the camera's intrinsics and pose and, when known, the robot's joint state. The world frame is
+// the simulation's (robot base at world::SceneLayout's pose), so the scene bounds and networks
+// trained in simulation apply.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "robot/robot_model.hpp"
+#include "stream/record.hpp"
+#include "voxels/observation_cloud.hpp"
+
+namespace qte::camera_recordings {
+
+struct CameraSetup {
+  std::string name = "front";                 // field prefix: <name>.rgb, <name>.depth_mm, ...
+  std::optional<Eigen::Matrix3d> intrinsics;  // pinhole K; needed for depth images
+  Eigen::Isometry3d camera_to_world = Eigen::Isometry3d::Identity();  // OpenCV axes: x right, y down, z forward
+  double depth_unit_m = 0.001;                // metres per depth count (RealSense: 0.001)
+  bool store_points = true;                   // also write <name>.points (plan-path needs them)
+};
+
+// The robot at one frame: arm joints (rad) and the distance between the fingers (m).
+struct RobotState {
+  robot::JointVector joints = robot::JointVector::Zero();
+  double gripper_opening_m = 0.085;
+};
+
+// Adds the camera's fields for a colour image (8-bit, 3 channels, BGR as OpenCV reads it) and a
+// depth image (16-bit, one channel, 0 = no return). Depth in millimetres is stored as is
+// (<name>.depth_mm, the replay's own form); any other unit as float metres (<name>.depth).
+// Throws Error naming `what` (the files) when the images do not fit together or the setup.
+void add_camera_images(stream::Record& obs, const CameraSetup& camera, const cv::Mat& bgr, const cv::Mat& depth,
+                       const std::string& what);
+
+// Adds the camera's fields for a cloud given in the camera frame (as a sensor's driver saves
+// it): <name>.points in the world frame, <name>.rgb, and the intrinsics when set.
+void add_camera_cloud(stream::Record& obs, const CameraSetup& camera, const voxels::CameraCloud& cloud);
+
+// joint_positions, joint_velocities (0), gripper_pose (forward kinematics), gripper_open
+// (fingers more than half open), gripper_opening_m.
+void add_robot_state(stream::Record& obs, const RobotState& state, const robot::RobotModel& robot,
+                     const Eigen::Isometry3d& world_from_base);
+
+// step, frame, episode_length, task, description, and an episode that has not ended
+// (reward 0, terminal 0, success 0, ignore_collisions 0, variation 0, episode_seed 0).
+void add_episode_fields(stream::Record& obs, int step, int episode_length, const std::string& task);
+
+// A CSV with one row per frame: 7 joint angles in radians, optionally the gripper opening in
+// metres as an 8th column; a first row that is not numbers is a header. Throws Error naming
+// the file, line and what was expected; joints outside the robot's limits are refused.
+std::vector<RobotState> read_joint_csv(const std::string& path, const robot::RobotModel& robot);
+
+}  // namespace qte::camera_recordings

@@ -1,0 +1,159 @@
+// obs-pack: saved RGB-D camera frames (colour + 16-bit depth PNGs, or .pcd clouds) to 'obs' records.
+#include <opencv2/imgcodecs.hpp>
+#include <sys/stat.h>
+
+#include "camera_recordings/camera_recordings.hpp"
+#include "cli/command.hpp"
+#include "point_clouds/pcd_file.hpp"
+#include "stream/writer.hpp"
+#include "world/scene_layout.hpp"
+
+using namespace qte;
+
+static cli::Usage usage() {
+  cli::Usage u;
+  u.name = "obs-pack";
+  u.summary = "turn saved RGB-D camera frames into observation records";
+  u.description = {
+      "Reads a real camera's saved frames and writes one 'obs' record per frame, the records "
+      "sim-step writes, so voxelize, qte-select and plan-path run on them as on simulated ones. "
+      "A frame is a colour PNG (--rgb) with a 16-bit depth PNG (--depth; counts of --depth-unit "
+      "metres, 0 = no return; a RealSense saves millimetres), or a .pcd point cloud (--pcd) in the "
+      "camera frame. File names are printf patterns with one integer conversion "
+      "(frames/color_%06d.png); frames are read from --start until the first index whose files "
+      "are missing, or --count of them.",
+      "The camera is given by --intrinsics (fx, fy, cx, cy in pixels; needed for depth images) "
+      "and its pose: --camera-pose (x, y, z, qx, qy, qz, qw) or --extrinsics (the 4x4 "
+      "camera-to-world matrix, row by row), camera axes as OpenCV's (x right, y down, z forward). "
+      "The world frame is the simulation's: the robot's base at (-0.3, 0, 0.752), facing +x; "
+      "express the camera's calibration there, so scene bounds and networks trained in "
+      "simulation apply.",
+      "With --joints each frame's robot state comes from a CSV row: 7 joint angles in radians "
+      "and optionally the gripper opening in metres (the xArm gripper's 0-850 units are 0-0.085 "
+      "m); the gripper pose follows by forward kinematics. Without it the records carry no joint "
+      "state and plan-path refuses them; qte-select needs only the gripper opening (open). "
+      "Records are written whole or not at all; a bad file stops with one line naming it.",
+  };
+  u.options = {
+      {"rgb", "PATTERN", "colour PNGs, e.g. frames/color_%06d.png", ""},
+      {"depth", "PATTERN", "16-bit depth PNGs matching --rgb, e.g. frames/depth_%06d.png", ""},
+      {"pcd", "PATTERN", "instead of --rgb/--depth: point clouds (.pcd, camera frame, with rgb if any)", ""},
+      {"start", "N", "index of the first frame", "0"},
+      {"count", "N", "frames to read (default: until the first missing index)", ""},
+      {"camera", "NAME", "camera name, the records' field prefix", "front"},
+      {"intrinsics", "FX,FY,CX,CY", "pinhole intrinsics in pixels (needed for depth images)", ""},
+      {"camera-pose", "X,Y,Z,QX,QY,QZ,QW", "camera-to-world pose, metres and unit quaternion", ""},
+      {"extrinsics", "M00,...,M33", "camera-to-world 4x4 matrix, 16 numbers row by row (instead of --camera-pose)", ""},
+      {"depth-unit", "M", "metres per depth count", "0.001"},
+      {"joints", "FILE.csv", "robot state per frame: 7 joint angles (rad)[, gripper opening (m)]", ""},
+      {"task", "NAME", "the records' task name", "real"},
+      {"episode-length", "N", "next-best poses per episode (the networks' time input scales by it)", "10"},
+      {"no-points", "", "do not store <camera>.points (readers rebuild them from depth; plan-path needs them)", ""},
+      {"output", "FILE", "where to write; '-' is standard output", "-"},
+  };
+  u.examples = {
+      {"obs-pack --rgb rec/color_%06d.png --depth rec/depth_%06d.png --intrinsics 615.2,615.0,320.5,240.1 "
+       "--camera-pose 1.0,0,1.4,-0.65,0.65,-0.27,0.27 --joints rec/joints.csv > real.rec",
+       "a RealSense recording with the arm's joint log"},
+      {"obs-pack ... < /dev/null | qte-select --checkpoint run/latest.rec --k 10 --png q/ | plan-path | stream-dump --type trajectory",
+       "what the learned agent would do on each saved frame"},
+      {"obs-pack --pcd clouds/%06d.pcd --camera-pose 1.0,0,1.4,-0.65,0.65,-0.27,0.27 | voxelize --png grids/",
+       "voxelize saved clouds and look at the grids"},
+  };
+  u.see_also = {"sim-step(1)", "voxelize(1)", "qte-select(1)", "plan-path(1)", "qte-stream(5)"};
+  return u;
+}
+
+static std::string frame_path(const std::string& pattern, int64_t index) {
+  char path[4096];
+  const int n = std::snprintf(path, sizeof path, pattern.c_str(), static_cast<long long>(index));
+  if (n < 0 || n >= static_cast<int>(sizeof path)) throw UsageError("file pattern '" + pattern + "' makes no path");
+  return path;
+}
+
+static bool exists(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0;
+}
+
+static camera_recordings::CameraSetup camera_setup(const cli::Arguments& args) {
+  camera_recordings::CameraSetup camera;
+  camera.name = args.text("camera");
+  if (!stream::is_valid_field_name(camera.name + ".rgb")) throw UsageError("--camera: not a usable field name");
+  if (args.has("intrinsics")) {
+    const auto k = args.reals("intrinsics", 4);
+    if (!(k[0] > 0 && k[1] > 0)) throw UsageError("--intrinsics: focal lengths must be positive");
+    Eigen::Matrix3d m;
+    m << k[0], 0, k[2], 0, k[1], k[3], 0, 0, 1;
+    camera.intrinsics = m;
+  }
+  if (args.has("camera-pose") == args.has("extrinsics")) throw UsageError("give the camera's pose: one of --camera-pose and --extrinsics");
+  if (args.has("camera-pose")) {
+    const auto p = args.reals("camera-pose", 7);
+    const Eigen::Quaterniond q(p[6], p[3], p[4], p[5]);
+    if (std::abs(q.norm() - 1) > 1e-3) throw UsageError("--camera-pose: the quaternion must have unit length");
+    camera.camera_to_world = Eigen::Translation3d(p[0], p[1], p[2]) * q.normalized();
+  } else {
+    const auto e = args.reals("extrinsics", 16);
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c) camera.camera_to_world.matrix()(r, c) = e[4 * r + c];
+    const Eigen::Matrix3d rotation = camera.camera_to_world.linear();
+    if (!(rotation.transpose() * rotation).isApprox(Eigen::Matrix3d::Identity(), 1e-4) ||
+        !camera.camera_to_world.matrix().row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1)))
+      throw UsageError("--extrinsics: not a rigid transform (rotation, translation, last row 0 0 0 1)");
+  }
+  camera.depth_unit_m = args.real("depth-unit", 1e-6, 1.0);
+  camera.store_points = !args.flag("no-points");
+  return camera;
+}
+
+static void run(const cli::Arguments& args) {
+  const bool images = args.has("rgb") || args.has("depth");
+  if (images == args.has("pcd")) throw UsageError("give --rgb and --depth, or --pcd");
+  if (images && !(args.has("rgb") && args.has("depth"))) throw UsageError("--rgb and --depth go together");
+  const camera_recordings::CameraSetup camera = camera_setup(args);
+  if (images && !camera.intrinsics) throw UsageError("depth images need --intrinsics");
+  const int64_t start = args.integer("start", 0, 1000000000);
+  const int64_t count = args.has("count") ? args.integer("count", 1, 1000000000) : -1;
+  const int episode_length = static_cast<int>(args.integer("episode-length", 1, 1000));
+  const robot::RobotModel robot = robot::RobotModel::xarm7();
+  std::vector<camera_recordings::RobotState> states;
+  if (args.has("joints")) states = camera_recordings::read_joint_csv(args.text("joints"), robot);
+
+  stream::RecordWriter writer(args.text("output"));
+  int64_t written = 0;
+  for (int64_t index = start; count < 0 || written < count; ++index) {
+    const std::string first = frame_path(args.text(images ? "rgb" : "pcd"), index);
+    if (!exists(first)) {
+      if (count >= 0) throw Error(first + ": no such frame (--count " + std::to_string(count) + ")");
+      break;
+    }
+    stream::Record obs("obs");
+    if (images) {
+      const std::string depth_path = frame_path(args.text("depth"), index);
+      const cv::Mat bgr = cv::imread(first, cv::IMREAD_COLOR);
+      const cv::Mat depth = cv::imread(depth_path, cv::IMREAD_UNCHANGED);
+      if (bgr.empty()) throw Error(first + ": not a readable image");
+      if (depth.empty()) throw Error(depth_path + ": not a readable image");
+      camera_recordings::add_camera_images(obs, camera, bgr, depth, first + " and " + depth_path);
+    } else {
+      camera_recordings::add_camera_cloud(obs, camera, point_clouds::read_pcd(first));
+    }
+    if (args.has("joints")) {
+      if (written >= static_cast<int64_t>(states.size()))
+        throw Error(args.text("joints") + ": no row for frame " + std::to_string(index) + " (" +
+                    std::to_string(states.size()) + " rows)");
+      camera_recordings::add_robot_state(obs, states[written], robot, world::SceneLayout{}.robot_base_pose());
+    } else {
+      obs.set_scalar<uint8_t>("gripper_open", 1);
+      obs.set_scalar<double>("gripper_opening_m", robot.max_finger_opening_m());
+    }
+    camera_recordings::add_episode_fields(obs, static_cast<int>(written), episode_length, args.text("task"));
+    writer.write(obs);
+    written += 1;
+  }
+  if (written == 0) throw Error(frame_path(args.text(images ? "rgb" : "pcd"), start) + ": no such frame");
+  writer.close();
+}
+
+int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }
