@@ -6,6 +6,7 @@
 
 #include "common/error.hpp"
 #include "common/random.hpp"
+#include "robot/joint_path.hpp"
 
 namespace qte::sim_step {
 namespace {
@@ -152,28 +153,12 @@ std::string Simulator::check_trajectory(const stream::Record& record) const {
   if (n < 1 || joints.shape != stream::Shape{n, robot::kArmJoints})
     record.fail("joint_positions", "float64 [N, 7] with N = " + std::to_string(n) +
                                        " (the length of time_s), got " + stream::shape_to_string(joints.shape));
-  for (int64_t i = 0; i < n * robot::kArmJoints; ++i)
-    if (!std::isfinite(joints[i])) return "invalid_trajectory:not_finite";
-  for (int64_t i = 0; i < n; ++i)
-    if (!std::isfinite(times[i]) || (i > 0 && times[i] <= times[i - 1]) || (i == 0 && times[0] != 0))
-      return "invalid_trajectory:time_s must start at 0 and increase";
-  if (times[n - 1] > options_.max_trajectory_s)
-    return "invalid_trajectory:longer than " + std::to_string(static_cast<int>(options_.max_trajectory_s)) + " s";
-  const robot::JointVector lo = robot_.lower_limits(), hi = robot_.upper_limits(),
-                           vmax = robot_.max_velocities();
-  for (int k = 0; k < robot::kArmJoints; ++k)
-    if (std::abs(joints[k] - world_->joint_positions()[k]) > kStartTolerance_rad)
-      return "invalid_trajectory:does not start at the current joint positions";
-  for (int64_t i = 0; i < n; ++i)
-    for (int k = 0; k < robot::kArmJoints; ++k) {
-      const double q = joints[i * robot::kArmJoints + k];
-      if (q < lo[k] - 1e-9 || q > hi[k] + 1e-9) return "joint_limits:joint" + std::to_string(k + 1);
-      if (i > 0) {
-        const double v = std::abs(q - joints[(i - 1) * robot::kArmJoints + k]) / (times[i] - times[i - 1]);
-        if (v > vmax[k] * 1.01) return "velocity_limit:joint" + std::to_string(k + 1);
-      }
-    }
-  return "";
+  robot::JointPathLimits limits;
+  limits.max_duration_s = options_.max_trajectory_s;
+  const robot::JointVector now = world_->joint_positions();
+  limits.start = &now;
+  limits.start_tolerance_rad = kStartTolerance_rad;
+  return robot::joint_path_failure(times.data, joints.data, n, robot_, limits);
 }
 
 void Simulator::execute(const stream::Record& record,

@@ -1,0 +1,34 @@
+// Planned joint paths in the form a real xArm 7 takes them: joint angles in degrees at a fixed
+// control rate (its servo mode, set_servo_angle_j) and the gripper in the xArm gripper's units
+// (0 closed .. 850 open), checked against the joint limits and speeds before anything is written.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "robot/joint_path.hpp"
+
+namespace qte::robot {
+
+constexpr double kXarmGripperOpenUnits = 850.0;  // the xArm gripper's position at its widest
+
+struct XarmRow {
+  double time_s = 0;
+  JointVector degrees = JointVector::Zero();
+  int gripper = 0;  // 0..850
+};
+
+// The path sampled every 1/rate_hz s (and at its end), linearly between waypoints as sim-step
+// follows it. The gripper holds `gripper_before_m` during the motion; one more row, `settle_s`
+// after the end, commands `gripper_after_m`. Throws Error with joint_path_failure()'s reason,
+// checked on the waypoints and again on the rows.
+std::vector<XarmRow> xarm_rows(const double* time_s, const double* joints, int64_t n, double gripper_before_m,
+                               double gripper_after_m, const RobotModel& robot, double rate_hz, double settle_s = 0.5);
+
+// CSV: a comment header saying what the columns are, then time_s,j1..j7 (degrees),gripper.
+std::string xarm_csv(const std::vector<XarmRow>& rows, const std::string& comment);
+
+// Metres between the fingers to gripper units and back.
+int xarm_gripper_units(double opening_m, const RobotModel& robot);
+
+}  // namespace qte::robot

@@ -1,0 +1,92 @@
+// xarm-export: plan-path's trajectories as files a real xArm 7 plays.
+#include <sys/stat.h>
+
+#include <cstdio>
+#include <iostream>
+
+#include "cli/command.hpp"
+#include "common/atomic_file.hpp"
+#include "robot/xarm_export.hpp"
+#include "stream/reader.hpp"
+
+using namespace qte;
+
+static cli::Usage usage() {
+  cli::Usage u;
+  u.name = "xarm-export";
+  u.summary = "write planned trajectories as xArm 7 joint files at a fixed control rate";
+  u.description = {
+      "Reads record streams holding 'trajectory' records (plan-path's output, or a whole "
+      "episode) and writes each planned motion as DIR/<record index>.xarm.csv, ready for a real "
+      "xArm 7: a few '#' comment lines (source, rate, units), a header, then one row per control "
+      "tick: time_s, the 7 joint angles j1_deg..j7_deg in degrees, and gripper, the xArm "
+      "gripper's position to hold (0 closed .. 850 open). Rows are the path sampled every "
+      "1/--rate seconds and at its end, linearly between the planned waypoints (as sim-step "
+      "follows them); the gripper holds its state from before the motion (the last observation's "
+      "opening, open when none came before), and one last row --settle seconds later commands "
+      "the trajectory's gripper_open (850 or 0).",
+      "Every path is checked before its file is written, on the waypoints and on the sampled "
+      "rows: finite, time starting at 0 and increasing, at most 60 s, within the xArm 7's joint "
+      "limits, and no joint faster than its 180 deg/s limit. A path that fails is an error "
+      "naming the record and the reason; a 'trajectory' that holds only a planner failure has no "
+      "motion and is skipped with a line on standard error. examples/xarm_play.py plays the "
+      "files on the arm with UFACTORY's Python SDK.",
+  };
+  u.arguments = {{"FILE", "record streams; '-' or absent is standard input", true, true}};
+  u.options = {
+      {"dir", "DIR", "where the files go (created if missing)", "."},
+      {"rate", "HZ", "control rate of the rows (the xArm's servo mode takes up to 250 Hz)", "100"},
+      {"settle", "S", "seconds after the motion at which the gripper command's row comes", "0.5"},
+  };
+  u.examples = {
+      {"plan-path < episode.rec | xarm-export --dir moves/", "plan each action of a saved episode for the arm"},
+      {"python3 examples/xarm_play.py --ip 192.168.1.185 moves/000004.xarm.csv", "play one move on the robot"},
+  };
+  u.see_also = {"plan-path(1)", "sim-step(1)", "qte-stream(5)"};
+  return u;
+}
+
+static void run(const cli::Arguments& args) {
+  std::vector<std::string> files = args.positional();
+  if (files.empty()) files.push_back("-");
+  const std::string dir = args.text("dir");
+  const double rate = args.real("rate", 1, 1000), settle = args.real("settle", 0, 60);
+  if (::mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) throw_system_error("cannot create directory " + dir);
+  const robot::RobotModel robot = robot::RobotModel::xarm7();
+  double gripper_m = robot.max_finger_opening_m();  // open until an observation says otherwise
+  for (const std::string& file : files) {
+    stream::RecordReader reader(file);
+    while (auto record = reader.next()) {
+      if (record->type() == "obs" && record->has("gripper_opening_m"))
+        gripper_m = record->scalar<double>("gripper_opening_m");
+      if (record->type() != "trajectory") continue;
+      const auto index = static_cast<unsigned long long>(record->position.record_index);
+      if (record->has("failure") && !record->has("time_s")) {
+        std::cerr << "xarm-export: " << file << ": record " << index << ": no motion (" << record->string("failure") << ")\n";
+        continue;
+      }
+      const auto times = record->array<double>("time_s");
+      const auto joints = record->array<double>("joint_positions");
+      if (times.shape.size() != 1 || joints.shape != stream::Shape{times.size(), robot::kArmJoints})
+        record->fail("joint_positions", "float64 [N, 7] with N the length of time_s");
+      const bool open = !record->has("gripper_open") || record->scalar<uint8_t>("gripper_open") != 0;
+      const double after_m = open ? robot.max_finger_opening_m() : 0.0;
+      std::vector<robot::XarmRow> rows;
+      try {
+        rows = robot::xarm_rows(times.data, joints.data, times.size(), gripper_m, after_m, robot, rate, settle);
+      } catch (const Error& e) {
+        throw StreamError(record->position, e.what());
+      }
+      char name[32];
+      std::snprintf(name, sizeof name, "/%06llu.xarm.csv", index);
+      const std::string comment = "# xArm 7 joint trajectory: " + file + ", record " + std::to_string(index) +
+                                  "\n# rows every " + std::to_string(1.0 / rate) +
+                                  " s; joints in degrees; gripper 0 (closed) .. 850 (open)\n";
+      const std::string csv = robot::xarm_csv(rows, comment);
+      write_file_atomically(dir + name, csv.data(), csv.size());
+      gripper_m = after_m;
+    }
+  }
+}
+
+int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }
