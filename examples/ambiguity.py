@@ -17,7 +17,8 @@ import sys
 
 import numpy as np
 
-from read_stream import read_records
+sys.path.insert(0, __file__.rsplit("/", 2)[0] + "/lib/python")  # or installed: make install
+from qte_stream import read_records  # noqa: E402
 
 TABLE_Z, REGION = 0.752, ((-0.05, 0.35), (-0.3, 0.3))
 

@@ -15,8 +15,8 @@ import sys
 import numpy as np
 import torch
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "examples"))
-from read_stream import read_records  # noqa: E402
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "lib" / "python"))
+from qte_stream import read_records  # noqa: E402
 
 
 def load_reference(path):

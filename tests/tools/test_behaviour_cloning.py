@@ -22,9 +22,8 @@ import numpy as np
 
 TOOLS = os.environ.get("QTE_TOOLS") or "/work/main/build/tools"
 SOURCE = os.environ.get("QTE_SOURCE") or "/work/main"
-spec = importlib.util.spec_from_file_location("read_stream", os.path.join(SOURCE, "examples", "read_stream.py"))
-read_stream = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(read_stream)
+sys.path.insert(0, os.path.join(SOURCE, "lib", "python"))
+import qte_stream as read_stream  # noqa: E402
 tmp = tempfile.mkdtemp(prefix="qte_bc_")
 
 

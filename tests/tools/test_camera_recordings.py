@@ -17,9 +17,8 @@ import numpy as np
 TOOLS = os.environ.get("QTE_TOOLS") or "/work/main/build/tools"
 SOURCE = os.environ.get("QTE_SOURCE") or "/work/main"
 tmp = tempfile.mkdtemp(prefix="qte_camrec_")
-spec = importlib.util.spec_from_file_location("read_stream", os.path.join(SOURCE, "examples", "read_stream.py"))
-qte_stream = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(qte_stream)
+sys.path.insert(0, os.path.join(SOURCE, "lib", "python"))
+import qte_stream  # noqa: E402
 
 
 def run(name, *args, stdin=None, ok=True):

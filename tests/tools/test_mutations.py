@@ -13,8 +13,8 @@ import os, random, re, struct, subprocess, sys, tempfile, time, zlib
 import numpy as np
 
 SOURCE = os.environ.get("QTE_SOURCE", ".")
-sys.path.insert(0, os.path.join(SOURCE, "examples"))
-import read_stream  # noqa: E402
+sys.path.insert(0, os.path.join(SOURCE, "lib", "python"))
+import qte_stream as read_stream  # noqa: E402
 
 TOOLS = os.environ.get("QTE_TOOLS", "build/tools")
 LIMIT = os.environ.get("QTE_MUTATIONS", "12")
@@ -61,7 +61,7 @@ def made(name, *args, stdin=None):
     return r.stdout
 
 
-# -- writing records (the reader is examples/read_stream.py; this is its inverse) ---------------
+# -- writing records (the reader is lib/python/qte_stream.py; this is its inverse) ---------------
 CODES = {np.dtype(v): k for k, v in read_stream.DTYPES.items() if k != read_stream.STR}
 
 

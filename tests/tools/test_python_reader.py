@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""examples/read_stream.py, stream-dump --json and stream-dump --npy all give back, bit for bit,
+"""The installed qte_stream module (lib/python/qte_stream.py), stream-dump --json and stream-dump --npy all give back, bit for bit,
 what stream-pack wrote: every dtype (extremes, NaN, infinities, -0), 0-d scalars, empty arrays,
 non-ASCII text and a zstd-compressed field. Damage makes the Python reader raise StreamError.
 Run with a python3 that has NumPy (ctest uses /usr/bin/python3)."""
@@ -20,10 +20,22 @@ SOURCE = os.environ.get("QTE_SOURCE") or "/work/main"
 tmp = tempfile.mkdtemp(prefix="qte_pyreader_")
 failures = []
 
-spec = importlib.util.spec_from_file_location(
-    "read_stream", os.path.join(SOURCE, "examples", "read_stream.py"))
-read_stream = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(read_stream)
+# The module as `make install` installs it (cmake --install, component python, into a scratch
+# prefix): it lands in the dist-packages Debian's python3 searches under /usr/local.
+BUILD = os.path.dirname(os.path.abspath(TOOLS))
+prefix = os.path.join(tmp, "prefix")
+r = subprocess.run(["cmake", "--install", BUILD, "--component", "python", "--prefix", prefix], capture_output=True, text=True)
+if r.returncode != 0:
+    sys.exit(f"FAIL: cmake --install --component python: {r.stderr}")
+installed = [os.path.join(d, f) for d, _, files in os.walk(prefix) for f in files if f == "qte_stream.py"]
+if len(installed) != 1:
+    sys.exit(f"FAIL: the install put {len(installed)} qte_stream.py under {prefix}")
+# Under the default prefix /usr/local that is on this python3's search path.
+where = os.path.join("/usr/local", os.path.relpath(os.path.dirname(installed[0]), prefix))
+if where not in sys.path:
+    sys.exit(f"FAIL: make install would put qte_stream in {where}, which {sys.executable} does not search")
+sys.path.insert(0, os.path.dirname(installed[0]))
+import qte_stream as read_stream  # noqa: E402
 
 
 def tool(name, *args, stdin=None):
@@ -101,7 +113,7 @@ except ImportError:
     have_zstd = False
 if not have_zstd:
     print("note: Python module zstandard missing, so the compressed record is not read with "
-          "read_stream.py (install python3-zstandard)")
+          "qte_stream (install python3-zstandard)")
 for source in (path, io.BytesIO(stream)):
     got = []
     try:
@@ -109,16 +121,16 @@ for source in (path, io.BytesIO(stream)):
             got.append(record)
     except read_stream.StreamError as e:  # without zstandard: at the last (compressed) record
         if have_zstd or len(got) != len(records) - 1 or "zstandard" not in str(e):
-            failures.append(f"read_stream.py: {e}")
+            failures.append(f"qte_stream: {e}")
     if len(got) != len(records) - (0 if have_zstd else 1):
-        failures.append(f"read_stream.py read {len(got)} records of {len(records)}")
+        failures.append(f"qte_stream read {len(got)} records of {len(records)}")
     for i, (record, (rtype, fields)) in enumerate(zip(got, records)):
         if (record.type, record.index, record.offset) != (rtype, i, offsets[i]):
             failures.append(f"record {i}: {record.type} #{record.index} @{record.offset}")
         if list(record.fields) != list(fields):
             failures.append(f"record {i}: fields {list(record.fields)}, expected {list(fields)}")
         for name, want in fields.items():
-            same(f"read_stream.py record {i} field {name}", record.fields.get(name), want)
+            same(f"qte_stream record {i} field {name}", record.fields.get(name), want)
 
 # --- 2. stream-dump --json --all-values -------------------------------------------------------
 SPECIAL = {"nan": np.nan, "inf": np.inf, "-inf": -np.inf}
@@ -178,7 +190,7 @@ for what, data, where in [("truncated payload", plain[:-5], f"record {len(record
     except Exception as e:  # noqa: BLE001 - any other exception is the failure tested for
         failures.append(f"{what}: {type(e).__name__} instead of StreamError: {e}")
 
-print("\n".join(failures) or f"{len(records)} records read back bit for bit by read_stream.py, "
+print("\n".join(failures) or f"{len(records)} records read back bit for bit by the installed qte_stream, "
       "stream-dump --json and stream-dump --npy; damage raises StreamError")
 if failures:
     sys.exit(f"FAIL ({len(failures)} mismatches; files kept in {tmp})")

@@ -39,11 +39,11 @@ stream-cat --exclude action "$tmp/greedy.rec" | cmp -s - "$tmp/in.rec" || fail "
 
 # The actions, checked with the NumPy reader: CHECK FILE K EXPLORED(0, 1 or any)
 check() {
-  $py - "$src/examples" "$@" <<'EOF' || fail "action check of $1 (k $2, explored $3)"
+  $py - "$src/lib/python" "$@" <<'EOF' || fail "action check of $1 (k $2, explored $3)"
 import sys
 import numpy as np
 sys.path.insert(0, sys.argv[1])
-from read_stream import read_records
+from qte_stream import read_records
 path, k, explored = sys.argv[2], int(sys.argv[3]), sys.argv[4]
 records = list(read_records(path))
 fields = ["pose", "gripper_open", "ignore_collisions"]
@@ -144,7 +144,7 @@ $py - "$src/examples" "$tmp/greedy.rec" "$tmp/k1.rec" "$tmp/auto0.rec" "$tmp/mas
 import sys
 import numpy as np
 sys.path.insert(0, sys.argv[1])
-from read_stream import read_records
+from qte_stream import read_records
 actions = [[r for r in read_records(path) if r.type == "action"] for path in sys.argv[2:]]
 greedy, k1, auto0, mass = actions
 assert all(list(a.fields["branches"]) == [10] for a in greedy), "--k 10 expands 10 at depth 1"

@@ -1,13 +1,18 @@
 #!/usr/bin/env python3
-"""Reads QTE record streams (formats/record-stream.md) with the standard library and NumPy.
+"""qte_stream: reads QTE record streams (formats/record-stream.md) with the standard library and
+NumPy (Debian's python3-numpy; a python3 from elsewhere may lack it).
 
-    for record in read_records("demos.rec"):
+    import qte_stream
+    for record in qte_stream.read_records("demos.rec"):
         print(record.index, record.type, record.fields["front.rgb"].shape)
+
+`make install` puts this module where Debian's python3 finds it (/usr/local/lib/python3.X/
+dist-packages); from a checkout, add lib/python to sys.path or PYTHONPATH.
 
 Records are checked as the C++ reader checks them; the first damage raises StreamError
 ("FILE: record I at byte O: what"). Arrays are read-only NumPy views of the payload (no copy);
 str fields are Python strings. zstd-compressed fields need the `zstandard` module.
-Run as a script to list the records of streams (like stream-dump).
+Run as a script (python3 -m qte_stream FILE...) to list the records of streams (like stream-dump).
 """
 import collections
 import os
@@ -202,8 +207,8 @@ def main(paths):
 if __name__ == "__main__":
     try:
         main(sys.argv[1:])
-    except BrokenPipeError:  # e.g. `read_stream.py demos.rec | head`: stop quietly
+    except BrokenPipeError:  # e.g. `python3 -m qte_stream demos.rec | head`: stop quietly
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         sys.exit(141)
     except (StreamError, OSError) as e:
-        sys.exit(f"read_stream.py: {e}")
+        sys.exit(f"qte_stream: {e}")
