@@ -27,9 +27,11 @@ static cli::Usage usage() {
       "zero-padded to 6 digits) and written atomically.",
       "With --video FILE.mp4 (or FILE.gif, an animated GIF for web pages) the camera's images "
       "become the frames of one video instead, at --fps. With --attention DIR, the pictures "
-      "qte-select --png DIR saved for the action chosen on each observation (DIR/<n>.depth<d>.png, "
-      "n counting the non-terminal observations from 0, as qte-select counts its actions) are "
-      "shown beside the camera; an observation without an action (the last) shows black there.",
+      "qte-select --png DIR saved for its actions (DIR/<n>.depth<d>.png, n from 0) are shown "
+      "beside the camera: on the observation the action was chosen on and, in a stream of every "
+      "control step (sim-step --every-step, replaying the episode's trajectories), on the frames "
+      "of the motion that carries it out. qte-select acts on the last observation of each step "
+      "that is not terminal; before the first action there is black.",
   };
   u.arguments = {{"FILE", "record streams; '-' or absent is standard input", true, true}};
   u.options = {
@@ -108,35 +110,80 @@ std::vector<cv::Mat> attention_pictures(const std::string& dir, int64_t action, 
 
 }  // namespace
 
+namespace {
+
+// The frames of a video, one observation behind the stream: qte-select acts on the last
+// observation of each step (with sim-step --every-step the frames during a motion share the
+// step of the observation that ends it), and only the next observation tells which that is.
+class EpisodeVideo {
+ public:
+  EpisodeVideo(const cli::Arguments& args)
+      : file_(args.text("video"), args.real("fps", 0.01, 1000)),
+        camera_(args.text("camera") + ".rgb"),
+        attention_(args.text("attention")),
+        height_(static_cast<int>(args.integer("height", 16, 4096))) {}
+
+  void add(const stream::Record& obs, bool shown) {
+    Frame next{shown ? image_of(obs, obs.field(camera_), false).clone() : cv::Mat(),
+               obs.has("step") ? obs.scalar<int32_t>("step") : -1,
+               obs.has("terminal") && obs.scalar<uint8_t>("terminal") != 0, true};
+    if (pending_.valid) write(pending_, next.step != pending_.step || pending_.step < 0);
+    pending_ = std::move(next);
+  }
+
+  void close() {
+    if (pending_.valid) write(pending_, true);
+    file_.close();
+  }
+
+ private:
+  struct Frame {
+    cv::Mat image;  // empty when --every skips it
+    int32_t step = -1;
+    bool terminal = false, valid = false;
+  };
+
+  // Each frame shows the pictures of the action chosen on it or, during a motion, of the action
+  // being carried out.
+  void write(const Frame& frame, bool acted_on) {
+    if (acted_on && !frame.terminal) action_ = actions_++;
+    if (frame.image.empty()) return;
+    const std::vector<cv::Mat> pictures =
+        attention_.empty() ? std::vector<cv::Mat>{} : attention_pictures(attention_, action_, picture_sizes_);
+    file_.add(video::side_by_side(frame.image, pictures, height_));
+  }
+
+  video::VideoFile file_;
+  std::string camera_, attention_;
+  int height_;
+  Frame pending_;
+  int64_t actions_ = 0, action_ = -1;
+  std::vector<cv::Size> picture_sizes_;
+};
+
+}  // namespace
+
 static void run(const cli::Arguments& args) {
   std::vector<std::string> files = args.positional();
   if (files.empty()) files.push_back("-");
-  const std::string dir = args.text("dir"), type = args.text("type"), camera = args.text("camera") + ".rgb";
-  const std::string attention = args.text("attention");
+  const std::string dir = args.text("dir"), type = args.text("type");
   const int64_t every = args.integer("every", 1, 1000000000);
-  const int height = static_cast<int>(args.integer("height", 16, 4096));
-  std::unique_ptr<video::VideoFile> video;
-  if (args.has("video")) video = std::make_unique<video::VideoFile>(args.text("video"), args.real("fps", 0.01, 1000));
-  else if (::mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) throw_system_error("cannot create directory " + dir);
-  if (!attention.empty() && !video) throw UsageError("--attention goes with --video");
-  int64_t seen = 0, actions = 0;
-  std::vector<cv::Size> picture_sizes;
+  std::unique_ptr<EpisodeVideo> video;
+  if (args.has("video")) {
+    if (type != "obs") throw UsageError("--video shows observations: --type obs");
+    video = std::make_unique<EpisodeVideo>(args);
+  } else if (::mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) {
+    throw_system_error("cannot create directory " + dir);
+  }
+  if (args.has("attention") && !video) throw UsageError("--attention goes with --video");
+  int64_t seen = 0;
   for (const auto& file : files) {
     stream::RecordReader reader(file);
     while (auto record = reader.next()) {
       if (record->type() != type) continue;
-      // qte-select acts on every non-terminal observation: that is its action index.
-      const bool acted = type == "obs" && !(record->has("terminal") && record->scalar<uint8_t>("terminal") != 0);
-      const int64_t action = acted ? actions++ : -1;
-      if (seen++ % every != 0) continue;
-      if (!video) {
-        save_pngs(*record, dir, args.flag("depth"), args.flag("depth-mm"));
-        continue;
-      }
-      const cv::Mat frame = image_of(*record, record->field(camera), false);
-      const std::vector<cv::Mat> pictures =
-          attention.empty() ? std::vector<cv::Mat>{} : attention_pictures(attention, action, picture_sizes);
-      video->add(video::side_by_side(frame, pictures, height));
+      const bool shown = seen++ % every == 0;
+      if (video) video->add(*record, shown);
+      else if (shown) save_pngs(*record, dir, args.flag("depth"), args.flag("depth-mm"));
     }
   }
   if (video) video->close();

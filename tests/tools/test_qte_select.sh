@@ -140,7 +140,7 @@ qte-select --checkpoint "$ckpt" --k auto --k-margin 1e9 --k-max 10 --seed 5 "$tm
   || fail "--k auto with an unbounded margin differs from --k 10"
 qte-select --checkpoint "$ckpt" --k auto --k-margin 0 "$tmp/in.rec" > "$tmp/auto0.rec" || fail "--k auto exit $?"
 qte-select --checkpoint "$ckpt" --k auto --k-mass 0.5 --k-max 4 "$tmp/in.rec" > "$tmp/mass.rec" || fail "--k-mass exit $?"
-$py - "$src/examples" "$tmp/greedy.rec" "$tmp/k1.rec" "$tmp/auto0.rec" "$tmp/mass.rec" <<'EOF2' || fail "--k auto's branches"
+$py - "$src/lib/python" "$tmp/greedy.rec" "$tmp/k1.rec" "$tmp/auto0.rec" "$tmp/mass.rec" <<'EOF2' || fail "--k auto's branches"
 import sys
 import numpy as np
 sys.path.insert(0, sys.argv[1])
