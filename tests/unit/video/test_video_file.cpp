@@ -4,11 +4,15 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "common/error.hpp"
+#include "video/episode_video.hpp"
 #include "video/video_file.hpp"
+
+#include <sys/stat.h>
 
 using namespace qte;
 
@@ -114,4 +118,60 @@ TEST(VideoFile, SideBySideScalesEveryPanelToOneHeight) {
   EXPECT_EQ(out.cols, 192 + 128 + 128);
   EXPECT_EQ(out.at<cv::Vec3b>(5, 192 + 3), cv::Vec3b(1, 2, 3));
   EXPECT_EQ(out.at<cv::Vec3b>(0, 0), camera.at<cv::Vec3b>(0, 0));
+}
+
+namespace {
+
+stream::Record observation(int step, bool terminal, uint8_t grey) {
+  stream::Record obs("obs");
+  obs.set<uint8_t>("front.rgb", {8, 8, 3}, std::vector<uint8_t>(8 * 8 * 3, grey));
+  obs.set_scalar<int32_t>("step", step);
+  obs.set_scalar<uint8_t>("terminal", terminal);
+  return obs;
+}
+
+// Which action's picture the attention panel of each GIF frame shows (action n's is red 60 * (n + 1);
+// the palette may round it by a few levels).
+std::vector<int> panel_actions(const std::string& path) {
+  int error = 0;
+  GifFileType* gif = DGifOpenFileName(path.c_str(), &error);
+  EXPECT_NE(gif, nullptr);
+  if (!gif) return {};
+  EXPECT_EQ(DGifSlurp(gif), GIF_OK);
+  std::vector<int> reds;
+  for (int i = 0; i < gif->ImageCount; ++i) {
+    const SavedImage& image = gif->SavedImages[i];
+    const int red = image.ImageDesc.ColorMap->Colors[image.RasterBits[4 * gif->SWidth + 12]].Red;  // row 4, column 12: the panel
+    reds.push_back((red + 30) / 60 - 1);
+  }
+  DGifCloseFile(gif, &error);
+  return reds;
+}
+
+}  // namespace
+
+// qte-select acts on the last observation of each step: the frames of a motion (sim-step
+// --every-step) show the action they carry out, the acted-on frame its own new action.
+TEST(EpisodeVideo, EachFrameShowsTheActionChosenOnItOrBeingCarriedOut) {
+  const std::string dir = temp("attention");
+  ::mkdir(dir.c_str(), 0755);
+  for (int n = 0; n < 2; ++n) {
+    char name[64];
+    std::snprintf(name, sizeof name, "/%06d.depth0.png", n);
+    cv::imwrite(dir + name, cv::Mat(8, 8, CV_8UC3, cv::Scalar(0, 0, 60 * (n + 1))));  // BGR: red
+  }
+  const std::string every_step = temp("every_step.gif");
+  video::EpisodeVideo v(every_step, 10, "front", dir, 8);
+  for (const auto& [step, terminal] : std::vector<std::pair<int, bool>>{{0, false}, {1, false}, {1, false}, {1, false}, {2, false}, {2, true}})
+    v.add(observation(step, terminal, 100));
+  v.close();
+  EXPECT_EQ(panel_actions(every_step), (std::vector<int>{0, 0, 0, 1, 1, 1}));
+
+  const std::string keyframes = temp("keyframes.gif");
+  video::EpisodeVideo k(keyframes, 10, "front", dir, 8);
+  k.add(observation(0, false, 100));
+  k.add(observation(1, false, 100), /*shown=*/false);  // counted, not shown (--every)
+  k.add(observation(2, true, 100));
+  k.close();
+  EXPECT_EQ(panel_actions(keyframes), (std::vector<int>{0, 1}));
 }
