@@ -2,6 +2,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sys/stat.h>
 
+#include <cctype>
+#include <cstring>
+
 #include "camera_recordings/camera_recordings.hpp"
 #include "cli/command.hpp"
 #include "point_clouds/pcd_file.hpp"
@@ -64,11 +67,34 @@ static cli::Usage usage() {
   return u;
 }
 
+// The pattern with its one integer conversion (%d, %06d, %i, %u with flags and width) filled in;
+// anything else ('%s', two conversions) is refused rather than handed to printf.
 static std::string frame_path(const std::string& pattern, int64_t index) {
-  char path[4096];
-  const int n = std::snprintf(path, sizeof path, pattern.c_str(), static_cast<long long>(index));
-  if (n < 0 || n >= static_cast<int>(sizeof path)) throw UsageError("file pattern '" + pattern + "' makes no path");
-  return path;
+  std::string out;
+  int conversions = 0;
+  for (std::size_t i = 0; i < pattern.size(); ++i) {
+    if (pattern[i] != '%') {
+      out += pattern[i];
+      continue;
+    }
+    if (i + 1 < pattern.size() && pattern[i + 1] == '%') {
+      out += '%';
+      ++i;
+      continue;
+    }
+    std::size_t j = i + 1;
+    while (j < pattern.size() && std::strchr("-+ 0#", pattern[j])) ++j;
+    while (j < pattern.size() && std::isdigit(static_cast<unsigned char>(pattern[j]))) ++j;
+    if (j >= pattern.size() || !std::strchr("diu", pattern[j]) || ++conversions > 1)
+      throw UsageError("file pattern '" + pattern + "': expected exactly one integer conversion such as %06d");
+    char number[64];
+    std::snprintf(number, sizeof number, ("%" + pattern.substr(i + 1, j - i - 1) + "lld").c_str(),
+                  static_cast<long long>(index));
+    out += number;
+    i = j;
+  }
+  if (conversions != 1) throw UsageError("file pattern '" + pattern + "': expected one integer conversion such as %06d");
+  return out;
 }
 
 static bool exists(const std::string& path) {
