@@ -192,7 +192,7 @@ def check(program, description, argv, data, output=None, stdout_stream=True, wor
         if output and os.path.isdir(output):  # a checkpoint directory
             output = os.path.join(output, "latest.rec")
         produced = r.stdout if stdout_stream else (open(output, "rb").read() if output and os.path.exists(output) else b"")
-        if stdout_stream or output:
+        if stdout_stream or (output and not output.endswith((".mp4", ".csv"))):  # those are not streams
             try:
                 records(produced)
             except read_stream.StreamError as e:
@@ -204,7 +204,7 @@ def check(program, description, argv, data, output=None, stdout_stream=True, wor
     for name in os.listdir(tmp):  # nothing of ours beside the inputs
         if ".tmp." in name:
             failures.append(f"{label}: temporary {name} left in the output directory")
-    for made_here in (out, png_dir, ckpt_out):
+    for made_here in (out, png_dir, ckpt_out, video, xarm_dir):
         subprocess.run(["rm", "-rf", made_here])
 
 
@@ -243,15 +243,22 @@ sim_input = [reset] + trajectory
 out = os.path.join(tmp, "out.rec")
 png_dir = os.path.join(tmp, "png")
 ckpt_out = os.path.join(tmp, "ckpt-out")
+video = os.path.join(tmp, "episode.mp4")
+xarm_dir = os.path.join(tmp, "xarm")
+trajectory_index = [i for i, r in enumerate(planned_recs) if r[0] == "trajectory"][0]
 runs = [
     # program, argv (INPUT: the mutated file), records to mutate, which of them, output file, stream on stdout?
     ("stream-dump", ["INPUT"], acted_recs, [0, 1], None, False),
     ("stream-cat", ["INPUT", "--output", out], acted_recs, [1], out, False),
     ("episode-stats", ["INPUT"], obs_recs[:3], [1], None, False),
     ("stream-png", ["--depth", "--dir", png_dir, "INPUT"], obs_recs[:1], [0], None, False),
+    ("stream-png", ["--video", video, "INPUT"], obs_recs[:2], [0, 1], video, False),
     ("voxelize", ["INPUT"], obs_recs[:1], [0], None, True),
+    ("voxelize", ["--crop", "-1,-1,0,1,1,2", "--outliers", "8,2", "--downsample", "0.01", "INPUT"], obs_recs[:1], [0], None, True),
     ("keyframe", ["--output", out, "INPUT"], demo_recs, first_of(demo_recs, "obs") + first_of(demo_recs, "episode"), out, False),
     ("plan-path", ["--seed", "1", "INPUT"], acted_recs, [0, 1], None, True),
+    ("xarm-export", ["--dir", xarm_dir, "INPUT"], planned_recs, [0, trajectory_index],
+     os.path.join(xarm_dir, f"{trajectory_index:06d}.xarm.csv"), False),
     ("qte-select", ["--checkpoint", checkpoint, "--k", "2", "--seed", "1", "INPUT"], acted_recs[:1], [0], None, True),
     ("qattn-train", ["--steps", "2", "--start-after", "0", "--checkpoint-every", "1", "--seed", "1",
                      "--checkpoint-dir", ckpt_out, "INPUT"], transition_recs,
