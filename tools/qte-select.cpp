@@ -1,6 +1,5 @@
 // qte-select: the acting agent. Observations in, next-best poses chosen by coarse-to-fine
 // Q-attention with tree expansion (C2F-ARM+QTE) out, with optional exploration.
-#include <sys/stat.h>
 
 #include <cerrno>
 #include <cmath>
@@ -9,6 +8,7 @@
 #include <random>
 
 #include "cli/command.hpp"
+#include "common/atomic_file.hpp"
 #include "common/random.hpp"
 #include "nets/qattention_net.hpp"
 #include "qattention/acting.hpp"
@@ -206,8 +206,7 @@ static void run(const cli::Arguments& args) {
   nets::set_torch_threads(static_cast<int>(threads));
   qattention::CheckpointNetworks networks(checkpoint);
   const voxels::CoarseToFine hierarchy = checkpoint_hierarchy(args, networks, checkpoint);
-  if (!png_dir.empty() && ::mkdir(png_dir.c_str(), 0755) != 0 && errno != EEXIST)
-    throw_system_error("cannot create directory " + png_dir);
+  if (!png_dir.empty()) make_output_directory(png_dir);
 
   const qattention::DepthEvaluator evaluate = qattention::network_evaluator(networks.nets());
   stream::RecordReader reader(args.positional().empty() ? "-" : args.positional()[0]);

@@ -1,11 +1,11 @@
 // stream-dump: print any record stream (text or JSON Lines), filter by type, export .npy.
-#include <sys/stat.h>
 
 #include <iostream>
 #include <map>
 #include <set>
 
 #include "cli/command.hpp"
+#include "common/atomic_file.hpp"
 #include "point_clouds/pcd_file.hpp"
 #include "stream/inspect.hpp"
 #include "stream/npy.hpp"
@@ -71,8 +71,7 @@ static void run(const cli::Arguments& args) {
   inspect.max_values = args.flag("all-values") ? -1 : args.integer("values", -1, 1000000000);
   const std::string npy_dir = args.text("npy"), pcd_dir = args.text("pcd");
   for (const std::string& dir : {npy_dir, pcd_dir})
-    if (!dir.empty() && ::mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST)
-      throw_system_error("cannot create directory " + dir);
+    if (!dir.empty()) make_output_directory(dir);
   stream::ReadOptions read_options;
   if (args.integer("max-record-bytes") <= 0) throw UsageError("--max-record-bytes must be positive");
   read_options.max_record_bytes = static_cast<uint64_t>(args.integer("max-record-bytes"));

@@ -1,5 +1,4 @@
 // stream-png: save the camera images of a stream as PNG files, or an episode as a video.
-#include <sys/stat.h>
 
 #include <cstdio>
 #include <opencv2/core.hpp>
@@ -7,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "cli/command.hpp"
+#include "common/atomic_file.hpp"
 #include "render/camera.hpp"
 #include "stream/reader.hpp"
 #include "video/episode_video.hpp"
@@ -89,8 +89,8 @@ static void run(const cli::Arguments& args) {
     video = std::make_unique<video::EpisodeVideo>(args.text("video"), args.real("fps", 0.01, 1000),
                                                   args.text("camera"), args.text("attention"),
                                                   static_cast<int>(args.integer("height", 16, 4096)));
-  } else if (::mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) {
-    throw_system_error("cannot create directory " + dir);
+  } else {
+    make_output_directory(dir);
   }
   if (args.has("attention") && !video) throw UsageError("--attention goes with --video");
   int64_t seen = 0;

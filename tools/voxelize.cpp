@@ -1,11 +1,11 @@
 // voxelize: observations to coarse-to-fine voxel grids (C2F-ARM's 10 channels).
-#include <sys/stat.h>
 
 #include <cmath>
 #include <cstdio>
 #include <sstream>
 
 #include "cli/command.hpp"
+#include "common/atomic_file.hpp"
 #include "point_clouds/cloud_filters.hpp"
 #include "stream/reader.hpp"
 #include "stream/writer.hpp"
@@ -70,8 +70,7 @@ static void run(const cli::Arguments& args) {
   const bool octomap_channels = args.flag("octomap-channels");
   const point_clouds::CloudFilters filters = point_clouds::parse_cloud_filters(args);
   const std::string png_dir = args.text("png");
-  if (!png_dir.empty() && ::mkdir(png_dir.c_str(), 0755) != 0 && errno != EEXIST)
-    throw_system_error("cannot create directory " + png_dir);
+  if (!png_dir.empty()) make_output_directory(png_dir);
 
   const std::size_t grid_floats = static_cast<std::size_t>(scene.voxels) * scene.voxels * scene.voxels * voxels::kChannels;
   stream::RecordReader reader(args.positional().empty() ? "-" : args.positional()[0]);

@@ -1,5 +1,4 @@
 // xarm-export: plan-path's trajectories as files a real xArm 7 plays.
-#include <sys/stat.h>
 
 #include <cstdio>
 #include <iostream>
@@ -51,7 +50,7 @@ static void run(const cli::Arguments& args) {
   if (files.empty()) files.push_back("-");
   const std::string dir = args.text("dir");
   const double rate = args.real("rate", 1, 1000), settle = args.real("settle", 0, 60);
-  if (::mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) throw_system_error("cannot create directory " + dir);
+  make_output_directory(dir);
   const robot::RobotModel robot = robot::RobotModel::xarm7();
   double gripper_m = robot.max_finger_opening_m();  // open until an observation says otherwise
   for (const std::string& file : files) {

@@ -157,4 +157,8 @@ void write_file_atomically(const std::string& path, const void* data, std::size_
   file.commit();
 }
 
+void make_output_directory(const std::string& path) {
+  if (::mkdir(path.c_str(), 0755) != 0 && errno != EEXIST) throw_system_error("cannot create directory " + path);
+}
+
 }  // namespace qte

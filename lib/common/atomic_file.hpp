@@ -39,6 +39,10 @@ void write_all(int fd, const void* data, std::size_t n, const std::string& what)
 // clean up, so the next program writing there does. Returns how many it removed.
 int remove_stale_temporaries(const std::string& dir, const std::string& name = "");
 
+// Creates the directory `path` where output files go, unless it exists (parents are not made).
+// Throws Error naming it otherwise.
+void make_output_directory(const std::string& path);
+
 // Convenience: the whole file at once, atomically.
 void write_file_atomically(const std::string& path, const void* data, std::size_t n);
 
