@@ -1,6 +1,7 @@
 #include "video/video_file.hpp"
 
 #include <gif_lib.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -113,6 +114,10 @@ void VideoFile::close() {
     gif_->file = nullptr;
     if (status != GIF_OK) throw Error("cannot write " + path_ + ": " + GifErrorString(error));
   }
+  // giflib creates its file for the owner alone; give it the mode any new file gets.
+  const mode_t mask = ::umask(0);
+  ::umask(mask);
+  ::chmod(temp_path_.c_str(), 0666 & ~mask);
   if (std::rename(temp_path_.c_str(), path_.c_str()) != 0) throw_system_error("cannot rename " + temp_path_ + " to " + path_);
   temp_path_.clear();
 }
