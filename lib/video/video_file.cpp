@@ -123,8 +123,7 @@ void VideoFile::close() {
 }
 
 cv::Mat side_by_side(const cv::Mat& camera_rgb, const std::vector<cv::Mat>& pictures_rgb, int height) {
-  std::vector<cv::Mat> panels;
-  for (const cv::Mat* m : {&camera_rgb}) panels.push_back(*m);
+  std::vector<cv::Mat> panels{camera_rgb};
   panels.insert(panels.end(), pictures_rgb.begin(), pictures_rgb.end());
   for (cv::Mat& p : panels) {
     cv::Mat scaled;
