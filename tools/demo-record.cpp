@@ -3,6 +3,7 @@
 
 #include "cli/command.hpp"
 #include "demos/demo_recorder.hpp"
+#include "sim_step/simulator_options.hpp"
 #include "stream/writer.hpp"
 #include "tasks/task.hpp"
 
@@ -23,19 +24,14 @@ static cli::Usage usage() {
       "said per episode.",
   };
   u.options = {
-      {"task", "T", "one of: " + tasks::task_list(), ""},
-      {"episodes", "N", "number of demonstrations", "10"},
-      {"variation", "V", "task variation, or 'random' for one per episode", "0"},
-      {"scenes", "SET", "the scene set episodes are drawn from: demo (disjoint from sim-step's explore and eval "
-                        "scenes for every --seed), explore, eval or any", "demo"},
+      {"task", "T", "one of: " + tasks::task_list(), "", false, true},
       {"retries", "N", "new seeds to try for an episode whose expert failed", "0"},
-      {"cameras", "LIST", "comma-separated cameras: front, wrist, overhead", "front"},
-      {"image-size", "WxH", "camera resolution", "128x128"},
       {"no-points", "", "leave point clouds out of the recorded observations (the planner still uses them)", ""},
-      {"compress", "", "zstd-compress images and point clouds", ""},
       {"time-budget", "S", "planner time budget per move, seconds", "2"},
       {"output", "FILE", "where to write; '-' is standard output", "-"},
   };
+  u.add_options(sim_step::episode_options(10, sim_step::SceneSet::demo));
+  u.add_options(sim_step::camera_options());
   u.uses_randomness = true;
   u.examples = {
       {"demo-record --task reach_target --episodes 10 --seed 0 --output demos.rec",
@@ -48,21 +44,13 @@ static cli::Usage usage() {
 }
 
 static void run(const cli::Arguments& args) {
-  if (!args.has("task")) throw UsageError("--task is required");
   demos::DemoOptions options;
-  options.episodes.task = args.text("task");
-  options.episodes.episodes = static_cast<int>(args.integer("episodes", 1, 1000000));
-  options.episodes.variation = args.text("variation") == "random" ? -1 : static_cast<int>(args.integer("variation", 0, 1000));
-  options.episodes.seed = args.seed();
-  options.episodes.scenes = sim_step::scene_set_from_name(args.text("scenes"));
+  options.episodes = sim_step::parse_episode_plan(args, args.text("task"));
   options.retries = static_cast<int>(args.integer("retries", 0, 1000));
   options.planner.time_budget_s = args.real("time-budget", 0.001, 600);
   options.planner.seed = args.seed();
-  options.simulator = sim_step::options_from_camera_arguments(args.text("cameras"), args.text("image-size"));
+  options.simulator = sim_step::parse_camera_options(args);
   options.simulator.point_clouds = true;  // the planner needs them; dropped on output with --no-points
-  options.simulator.compress_images = args.flag("compress");
-  if (options.episodes.episodes < 1 || options.retries < 0) throw UsageError("--episodes >= 1 and --retries >= 0");
-  tasks::make_task(options.episodes.task);  // an unknown task fails before anything is written
 
   const robot::RobotModel robot = robot::RobotModel::xarm7();
   stream::RecordWriter writer(args.text("output"));

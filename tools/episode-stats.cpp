@@ -38,7 +38,7 @@ static cli::Usage usage() {
       "unfinished episode: it is not counted and a line on standard error says so. Text cells "
       "that hold a comma, a quote or a line break are quoted as RFC 4180 says.",
   };
-  u.arguments = {{"FILE", "record streams to read in order; '-' is standard input", true, true}};
+  u.arguments = {cli::input_files()};
   u.options = {
       {"label", "TEXT", "add a first column 'label' holding TEXT to every row", ""},
       {"column", "NAME=VALUE", "add a column NAME holding VALUE to every row, after 'label'", "", true},
@@ -60,8 +60,7 @@ static cli::Usage usage() {
 }
 
 static void run(const cli::Arguments& args) {
-  std::vector<std::string> files = args.positional();
-  if (files.empty()) files.push_back("-");
+  const std::vector<std::string> files = args.inputs();
   std::vector<report::Episode> episodes;
   for (const std::string& file : files) {
     const auto more = report::read_episodes(file, [](const std::string& line) {

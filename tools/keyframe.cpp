@@ -5,6 +5,7 @@
 #include "keyframes/transitions.hpp"
 #include "stream/reader.hpp"
 #include "stream/writer.hpp"
+#include "voxels/hierarchy_options.hpp"
 
 using namespace qte;
 
@@ -39,13 +40,9 @@ static cli::Usage usage() {
       "episode is kept, successful or not, and written as soon as it ends (terminal "
       "observation), so with --append a learner following the file sees it at once.",
   };
-  u.arguments = {{"FILE", "demonstrations; '-' or absent is standard input", true, false}};
+  u.arguments = {cli::input_file("demonstrations")};
   u.options = {
       {"every", "N", "start a demo-augmentation chain at every N-th frame; 0 for none", "10"},
-      {"voxels", "V", "voxels per side at every depth", "16"},
-      {"depths", "D", "coarse-to-fine depths", "2"},
-      {"offset", "M[,M...]", "half edge of the grids of each depth below 0, metres (one per depth: 0.15,0.05 for 3)", "0.15"},
-      {"bounds", "X,Y,Z,S", "scene bounds: minimum corner and edge length, metres", "-0.3,-0.5,0.6,1.0"},
       {"no-crop-augmentation", "", "use the unshifted centres for the deeper grids", ""},
       {"keep-failed", "", "also convert unsuccessful episodes (reward 0 throughout)", ""},
       {"not-demo", "", "mark the transitions as the agent's own, not demonstrations", ""},
@@ -53,6 +50,7 @@ static cli::Usage usage() {
       {"append", "", "append to --output (a growing replay file)", ""},
       {"agent", "", "convert the agent's episodes (obs and action records) instead of demonstrations", ""},
   };
+  u.add_options(voxels::hierarchy_options());
   u.uses_randomness = true;
   u.examples = {
       {"demo-record --task reach_target --episodes 10 | keyframe > demo_transitions.rec",
@@ -67,19 +65,15 @@ static cli::Usage usage() {
 static void run(const cli::Arguments& args) {
   keyframes::TransitionOptions options;
   options.augmentation_every_n = static_cast<int>(args.integer("every", 0, 100000));
-  options.hierarchy.scene = voxels::GridBounds::parse(args.text("bounds"), static_cast<int>(args.integer("voxels", 2, 256)));
-  options.hierarchy.depths = static_cast<int>(args.integer("depths", 1, 8));
-  options.hierarchy.offsets_m = voxels::CoarseToFine::parse_offsets(args.text("offset"), options.hierarchy.depths);
+  options.hierarchy = voxels::parse_hierarchy(args);
   options.crop_augmentation = !args.flag("no-crop-augmentation");
   options.keep_failed = args.flag("keep-failed");
   options.demo = !args.flag("not-demo");
   options.seed = args.seed();
-  if (options.augmentation_every_n < 0 || options.hierarchy.depths < 1 || options.hierarchy.scene.voxels < 2)
-    throw UsageError("--every >= 0, --depths >= 1 and --voxels >= 2");
 
   stream::WriteOptions write_options;
   if (args.flag("append")) write_options.mode = stream::WriteMode::append;
-  stream::RecordReader reader(args.positional().empty() ? "-" : args.positional()[0]);
+  stream::RecordReader reader(args.input());
   stream::RecordWriter writer(args.text("output"), write_options);
   const auto emit = [&](const stream::Record& r) { writer.write(r); };
   const auto convert_all = [&](auto&& converter) {

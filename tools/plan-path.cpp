@@ -2,9 +2,9 @@
 #include "cli/command.hpp"
 #include "planning/motion_planner.hpp"
 #include "point_clouds/cloud_filters.hpp"
-#include "world/scene_layout.hpp"
 #include "stream/reader.hpp"
 #include "stream/writer.hpp"
+#include "world/scene_layout.hpp"
 
 using namespace qte;
 
@@ -31,7 +31,7 @@ static cli::Usage usage() {
       "ignore_collisions set follow a straight line of the gripper instead (grasp approaches).",
       "Same inputs and --seed give the same bytes, unless a plan hits the time budget.",
   };
-  u.arguments = {{"FILE", "input records; '-' or absent is standard input", true, false}};
+  u.arguments = {cli::input_file()};
   u.options = {
       {"time-budget", "S", "seconds RRT-Connect may search before reporting timeout", "2"},
       {"velocity-scale", "F", "fraction of the joints' 180 deg/s to move at", "0.5"},
@@ -41,7 +41,7 @@ static cli::Usage usage() {
       {"octomap", "FILE.bt", "write the scene map of the last planned action (opens in octovis)", ""},
       {"output", "FILE", "where to write; '-' is standard output", "-"},
   };
-  for (auto& option : point_clouds::cloud_filter_options()) u.options.push_back(option);
+  u.add_options(point_clouds::cloud_filter_options());
   u.uses_randomness = true;
   u.examples = {
       {"sim-step --task reach_target < fifo | qte-select --checkpoint ckpt/latest.rec | plan-path > fifo",
@@ -70,7 +70,7 @@ static void run(const cli::Arguments& args) {
   const point_clouds::CloudFilters filters = point_clouds::parse_cloud_filters(args);
   if (filters.any())
     filter.observe_through([filters](const stream::Record& obs) { return point_clouds::filter_observation(obs, filters); });
-  stream::RecordReader reader(args.positional().empty() ? "-" : args.positional()[0]);
+  stream::RecordReader reader(args.input());
   stream::RecordWriter writer(args.text("output"));
   while (auto record = reader.next())
     filter.handle(*record, [&](const stream::Record& r) { writer.write(r); });

@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <tuple>
 
+#include <array>
+
 #include "cli/command.hpp"
 #include "common/error.hpp"
 #include "report/csv.hpp"
@@ -43,11 +45,11 @@ static cli::Usage usage() {
   };
   u.arguments = {{"CSV", "tables to read in order; '-' is standard input", false, true}};
   u.options = {
-      {"x", "COLUMN", "column of the horizontal axis, e.g. step (required)", ""},
-      {"y", "COLUMN", "column of the vertical axis, e.g. success_rate (required)", ""},
+      {"x", "COLUMN", "column of the horizontal axis, e.g. step", "", false, true},
+      {"y", "COLUMN", "column of the vertical axis, e.g. success_rate", "", false, true},
       {"group", "COLUMN", "one curve per distinct value of COLUMN (e.g. label or method)", ""},
       {"band", "KIND", "band around each mean: std, ci or none", "std"},
-      {"output", "FILE", "the PNG file to write (required)", ""},
+      {"output", "FILE", "the PNG file to write", "", false, true},
       {"title", "T", "title above the plot", ""},
       {"x-label", "L", "label of the horizontal axis (default: the --x column)", ""},
       {"y-label", "L", "label of the vertical axis (default: the --y column)", ""},
@@ -86,13 +88,8 @@ static std::pair<int, int> parse_size(const std::string& text) {
 static void run(const cli::Arguments& args) {
   report::CurveColumns columns{args.text("x"), args.text("y"), args.text("group")};
   const std::string output = args.text("output");
-  if (columns.x.empty() || columns.y.empty()) throw UsageError("--x and --y are required");
-  if (output.empty()) throw UsageError("--output is required");
-  const std::string band_name = args.text("band");
-  const report::Band band = band_name == "std"    ? report::Band::std_dev
-                            : band_name == "ci"   ? report::Band::ci
-                            : band_name == "none" ? report::Band::none
-                            : throw UsageError("--band: expected std, ci or none, got '" + band_name + "'");
+  const report::Band band =
+      std::array{report::Band::std_dev, report::Band::ci, report::Band::none}[args.choice("band", {"std", "ci", "none"})];
   report::CurvePlotOptions plot;
   std::tie(plot.width_px, plot.height_px) = parse_size(args.text("size"));
   plot.fixed_y = args.has("y-range");

@@ -4,12 +4,13 @@
 #include <iostream>
 
 #include "cli/command.hpp"
-#include "qattention/branching_options.hpp"
 #include "learner/q_learner.hpp"
 #include "learner/training_files.hpp"
 #include "learner/training_loop.hpp"
 #include "nets/qattention_net.hpp"
+#include "qattention/branching_options.hpp"
 #include "replay/replay_buffer.hpp"
+#include "voxels/hierarchy_options.hpp"
 
 using namespace qte;
 
@@ -66,6 +67,7 @@ static cli::Usage usage() {
       "64 base channels, 0.88 M / 1.19 M parameters, 1.8 GMAC per sample: 20 times the work "
       "per step on a CPU).",
   };
+  // FILE and --checkpoint-dir are needed for training, not for the --steps-allowed query.
   u.arguments = {{"FILE", "frame and transition records; '-' is standard input (at least one)", true, true}};
   u.options = {
       {"checkpoint-dir", "DIR", "where checkpoints go (required)", ""},
@@ -84,10 +86,6 @@ static cli::Usage usage() {
       {"log-every", "N", "steps between metrics rows and progress lines", "10"},
       {"architecture", "A", "network per depth: light or arm", "light"},
       {"base-channels", "C", "first-level kernels (default: light 16, arm 64)", ""},
-      {"voxels", "V", "voxels per side at every depth", "16"},
-      {"depths", "D", "coarse-to-fine depths", "2"},
-      {"offset", "M[,M...]", "half edge of the grids of each depth below 0, metres (one per depth: 0.15,0.05 for 3)", "0.15"},
-      {"bounds", "X,Y,Z,S", "scene bounds: minimum corner and edge length, metres", "-0.3,-0.5,0.6,1.0"},
       {"batch", "B", "transitions per step (published: 128)", "32"},
       {"gamma", "G", "discount", "0.99"},
       {"reward-scale", "F", "reward multiplier in the target", "0.01"},
@@ -106,7 +104,8 @@ static cli::Usage usage() {
       {"capacity", "N", "replay capacity in transitions (demos always kept)", "100000"},
       {"threads", "N", "LibTorch threads", "2"},
   };
-  for (auto& option : qattention::branching_options()) u.options.push_back(option);
+  u.add_options(voxels::hierarchy_options());
+  u.add_options(qattention::branching_options());
   u.uses_randomness = true;
   u.examples = {
       {"qattn-train --checkpoint-dir ckpt --steps 2000 --metrics train.csv demos.rec",
@@ -124,9 +123,7 @@ static void run(const cli::Arguments& args) {
   config.net.architecture = nets::architecture_from_name(args.text("architecture"));
   config.net.base_channels = args.has("base-channels") ? static_cast<int>(args.integer("base-channels", 1, 512))
                                                        : nets::default_base_channels(config.net.architecture);
-  config.hierarchy.scene = voxels::GridBounds::parse(args.text("bounds"), static_cast<int>(args.integer("voxels", 4, 128)));
-  config.hierarchy.depths = static_cast<int>(args.integer("depths", 1, 8));
-  config.hierarchy.offsets_m = voxels::CoarseToFine::parse_offsets(args.text("offset"), config.hierarchy.depths);
+  config.hierarchy = voxels::parse_hierarchy(args, 4, 128);  // the networks' smallest and largest grids
   config.batch = static_cast<int>(args.integer("batch", 1, 100000));
   config.gamma = args.real("gamma");
   config.reward_scale = args.real("reward-scale");

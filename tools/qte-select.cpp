@@ -11,14 +11,15 @@
 #include "common/atomic_file.hpp"
 #include "common/random.hpp"
 #include "nets/qattention_net.hpp"
+#include "point_clouds/cloud_filters.hpp"
 #include "qattention/acting.hpp"
 #include "qattention/action_record.hpp"
-#include "point_clouds/cloud_filters.hpp"
 #include "qattention/branching_options.hpp"
 #include "qattention/proprio.hpp"
 #include "stream/reader.hpp"
 #include "stream/writer.hpp"
 #include "voxels/grid_fields.hpp"
+#include "voxels/hierarchy_options.hpp"
 #include "voxels/observation_cloud.hpp"
 
 using namespace qte;
@@ -66,15 +67,11 @@ static cli::Usage usage() {
       "by Q (blue low, red high) and the chosen voxel outlined in red. It costs one more forward "
       "per depth.",
   };
-  u.arguments = {{"FILE", "input records; '-' or absent is standard input", true, false}};
+  u.arguments = {cli::input_file()};
   u.options = {
-      {"checkpoint", "FILE", "the networks: a 'checkpoint' record as qattn-train writes it (required)", ""},
+      {"checkpoint", "FILE", "the networks: a 'checkpoint' record as qattn-train writes it", "", false, true},
       {"k", "K", "voxels expanded per non-leaf grid; 1 is C2F-ARM's greedy choice; 'auto': as many as the "
                  "node's Q volume asks for (--k-margin or --k-mass, at most --k-max)", "10"},
-      {"voxels", "V", "voxels per side of every grid (default: the checkpoint's; must agree with it)", ""},
-      {"depths", "D", "coarse-to-fine depths (default: the checkpoint's; must agree with it)", ""},
-      {"bounds", "X,Y,Z,S", "scene bounds: minimum corner and edge length in metres (default: the checkpoint's, else -0.3,-0.5,0.6,1.0); must agree with the checkpoint's", ""},
-      {"offset", "M[,M...]", "half edge of the grids of each depth below 0, metres (default: the checkpoint's, else 0.15); must agree with the checkpoint's", ""},
       {"epsilon", "E", "probability, per depth, of a random voxel instead of the chosen one", "0"},
       {"index-noise", "SIGMA", "standard deviation of Gaussian noise on the last depth's voxel index, voxels", "0"},
       {"rotation-noise", "BINS", "standard deviation of Gaussian noise on the rotation bins (5 degrees each)", "0"},
@@ -90,8 +87,9 @@ static cli::Usage usage() {
       {"png", "DIR", "save the Q-values of every depth's grid as DIR/<n>.depth<d>.png", ""},
       {"output", "FILE", "where to write; '-' is standard output", "-"},
   };
-  for (auto& option : qattention::branching_options()) u.options.push_back(option);
-  for (auto& option : point_clouds::cloud_filter_options()) u.options.push_back(option);
+  u.add_options(voxels::checkpoint_hierarchy_options());
+  u.add_options(qattention::branching_options());
+  u.add_options(point_clouds::cloud_filter_options());
   u.uses_randomness = true;
   u.examples = {
       {"sim-step --task reach_target --episodes 10 < fifo | qte-select --checkpoint ckpt.rec | plan-path > fifo",
@@ -135,44 +133,6 @@ qattention::Exploration exploration_from(const cli::Arguments& args) {
   return exploration;
 }
 
-// The hierarchy the networks were trained on; --voxels, --depths, --bounds and --offset that
-// differ from it are refused (they fill it in for checkpoints written before it was kept).
-voxels::CoarseToFine checkpoint_hierarchy(const cli::Arguments& args, const qattention::CheckpointNetworks& networks,
-                                          const std::string& checkpoint) {
-  const auto agree = [&](const char* option, int checkpoint_value) {
-    if (args.has(option) && args.integer(option) != checkpoint_value)
-      throw UsageError(std::string("--") + option + " " + args.text(option) + " differs from the checkpoint's " +
-                       std::to_string(checkpoint_value) + " (" + checkpoint + ")");
-  };
-  agree("voxels", networks.config().net.voxels);
-  agree("depths", networks.config().depths);
-  voxels::CoarseToFine hierarchy = networks.hierarchy().value_or(voxels::CoarseToFine{});
-  hierarchy.depths = networks.config().depths;
-  hierarchy.scene.voxels = networks.config().net.voxels;
-  try {
-    if (args.has("bounds")) {
-      const voxels::GridBounds given = voxels::GridBounds::parse(args.text("bounds"), hierarchy.voxels());
-      if (networks.hierarchy() && voxels::bounds_values(given) != voxels::bounds_values(hierarchy.scene))
-        throw UsageError("--bounds " + args.text("bounds") + " differs from the bounds the checkpoint was trained on (" +
-                         checkpoint + ")");
-      hierarchy.scene = given;
-    }
-    if (args.has("offset")) {
-      const std::vector<double> given = voxels::CoarseToFine::parse_offsets(args.text("offset"), hierarchy.depths);
-      if (networks.hierarchy() && given != hierarchy.offsets_m)
-        throw UsageError("--offset " + args.text("offset") + " differs from the offsets the checkpoint was trained on (" +
-                         checkpoint + ")");
-      hierarchy.offsets_m = given;
-    }
-    hierarchy.validate();
-  } catch (const UsageError&) {
-    throw;
-  } catch (const Error& e) {
-    throw UsageError(e.what());
-  }
-  return hierarchy;
-}
-
 // One observation's action; an error of the networks (a diverged checkpoint) names the record.
 // The action's pictures read `observed` later: it must outlive the action.
 qattention::Action act_on(const stream::Record& obs, const voxels::ObservationCloud& observed, int32_t step,
@@ -195,7 +155,6 @@ qattention::Action act_on(const stream::Record& obs, const voxels::ObservationCl
 
 static void run(const cli::Arguments& args) {
   const std::string checkpoint = args.text("checkpoint");
-  if (checkpoint.empty()) throw UsageError("--checkpoint FILE is required");
   const qattention::Branching branching = qattention::parse_branching(args, "k", 1);
   const int64_t threads = args.integer("threads", 1, 256);
   const qattention::Exploration exploration = exploration_from(args);
@@ -205,11 +164,12 @@ static void run(const cli::Arguments& args) {
 
   nets::set_torch_threads(static_cast<int>(threads));
   qattention::CheckpointNetworks networks(checkpoint);
-  const voxels::CoarseToFine hierarchy = checkpoint_hierarchy(args, networks, checkpoint);
+  const voxels::CoarseToFine hierarchy = voxels::checkpoint_hierarchy(
+      args, networks.hierarchy(), networks.config().net.voxels, networks.config().depths, checkpoint);
   if (!png_dir.empty()) make_output_directory(png_dir);
 
   const qattention::DepthEvaluator evaluate = qattention::network_evaluator(networks.nets());
-  stream::RecordReader reader(args.positional().empty() ? "-" : args.positional()[0]);
+  stream::RecordReader reader(args.input());
   stream::RecordWriter writer(args.text("output"));
   uint64_t actions = 0;
   while (auto record = reader.next()) {

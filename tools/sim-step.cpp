@@ -3,6 +3,7 @@
 
 #include "cli/command.hpp"
 #include "sim_step/simulator.hpp"
+#include "sim_step/simulator_options.hpp"
 #include "stream/reader.hpp"
 #include "stream/writer.hpp"
 #include "tasks/task.hpp"
@@ -36,22 +37,17 @@ static cli::Usage usage() {
       "with per-object colours, diffuse shading and textures (the digits of lift_numbered_block, "
       "the board of setup_checkers). Tasks: " + tasks::task_list() + ".",
   };
-  u.arguments = {{"FILE", "input records; '-' or absent is standard input", true, false}};
+  u.arguments = {cli::input_file()};
   u.options = {
-      {"task", "T", "run episodes of task T by itself (see --episodes)", ""},
-      {"episodes", "N", "episodes to run with --task", "1"},
-      {"variation", "V", "task variation with --task, or 'random' for one per episode", "0"},
-      {"scenes", "SET", "with --task, the scene set episodes are drawn from: demo, explore, eval (disjoint for every "
-                        "--seed) or any", "any"},
-      {"cameras", "LIST", "comma-separated cameras: front, wrist, overhead", "front"},
-      {"image-size", "WxH", "camera resolution, e.g. 128x128 or 256x256", "128x128"},
+      {"task", "T", "run episodes of task T by itself (--episodes, --variation and --scenes apply to them)", ""},
       {"every-step", "", "also write an observation at every 50 ms control step of a trajectory "
                          "(full demonstrations)", ""},
       {"no-points", "", "leave the world-frame point clouds out of observations", ""},
-      {"compress", "", "zstd-compress images and point clouds (for files on disk)", ""},
       {"threads", "N", "rendering threads", "2"},
       {"output", "FILE", "where to write; '-' is standard output", "-"},
   };
+  u.add_options(sim_step::episode_options(1, sim_step::SceneSet::any));
+  u.add_options(sim_step::camera_options());
   u.uses_randomness = true;
   u.examples = {
       {"sim-step --task reach_target --seed 3 < /dev/null | stream-png --dir frames/",
@@ -66,24 +62,16 @@ static cli::Usage usage() {
 }
 
 static void run(const cli::Arguments& args) {
-  sim_step::SimulatorOptions options =
-      sim_step::options_from_camera_arguments(args.text("cameras"), args.text("image-size"));
+  sim_step::SimulatorOptions options = sim_step::parse_camera_options(args);
   options.observe_every_step = args.flag("every-step");
   options.point_clouds = !args.flag("no-points");
-  options.compress_images = args.flag("compress");
   options.render_threads = static_cast<int>(args.integer("threads", 1, 256));
-  if (options.render_threads < 1) throw UsageError("--threads must be at least 1");
 
   const robot::RobotModel robot = robot::RobotModel::xarm7();
   sim_step::Simulator simulator(robot, options);
   std::optional<sim_step::EpisodePlan> plan;
-  if (args.has("task")) {
-    plan = sim_step::EpisodePlan{args.text("task"), 0, static_cast<int>(args.integer("episodes", 1, 10000000)), args.seed()};
-    plan->variation = args.text("variation") == "random" ? -1 : static_cast<int>(args.integer("variation", 0, 1000));
-    plan->scenes = sim_step::scene_set_from_name(args.text("scenes"));
-    tasks::make_task(plan->task);  // an unknown task fails before anything is written
-  }
-  const std::string input = args.positional().empty() ? "-" : args.positional()[0];
+  if (args.has("task")) plan = sim_step::parse_episode_plan(args, args.text("task"));
+  const std::string input = args.input();
   std::unique_ptr<stream::RecordReader> reader;
   stream::RecordWriter writer(args.text("output"));
   sim_step::run_filter(

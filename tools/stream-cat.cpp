@@ -20,7 +20,7 @@ static cli::Usage usage() {
       "counted. With --append the records are added to the end of an existing file, one whole "
       "record at a time under a lock, which is how several actors feed one replay file.",
   };
-  u.arguments = {{"FILE", "record streams to read in order; '-' is standard input", true, true}};
+  u.arguments = {cli::input_files()};
   u.options = {
       {"output", "FILE", "where to write; '-' is standard output", "-"},
       {"append", "", "append to --output instead of replacing it", ""},
@@ -62,8 +62,7 @@ struct Condition {
 }  // namespace
 
 static void run(const cli::Arguments& args) {
-  std::vector<std::string> files = args.positional();
-  if (files.empty()) files.push_back("-");
+  const std::vector<std::string> files = args.inputs();
   const auto keep = args.all("type"), drop = args.all("exclude");
   const std::set<std::string> keep_types(keep.begin(), keep.end()),
       drop_types(drop.begin(), drop.end());

@@ -31,7 +31,7 @@ static cli::Usage usage() {
       "rebuilt from depth) with its colours, binary XYZRGB, organized as the image (NaN where a "
       "pixel has no return), for pcl_viewer and other PCL programs.",
   };
-  u.arguments = {{"FILE", "record streams to read in order; '-' is standard input", true, true}};
+  u.arguments = {cli::input_files()};
   u.options = {
       {"json", "", "print JSON Lines instead of text", ""},
       {"type", "T", "show only records of type T", "", true},
@@ -63,8 +63,7 @@ static void flush_or_stop() {
 }
 
 static void run(const cli::Arguments& args) {
-  std::vector<std::string> files = args.positional();
-  if (files.empty()) files.push_back("-");
+  const std::vector<std::string> files = args.inputs();
   const auto wanted = args.all("type");
   const std::set<std::string> types(wanted.begin(), wanted.end());
   stream::InspectOptions inspect;

@@ -33,7 +33,7 @@ static cli::Usage usage() {
       "of the motion that carries it out. qte-select acts on the last observation of each step "
       "that is not terminal; before the first action there is black.",
   };
-  u.arguments = {{"FILE", "record streams; '-' or absent is standard input", true, true}};
+  u.arguments = {cli::input_files("record streams")};
   u.options = {
       {"dir", "DIR", "where the PNG files go (created if missing)", "."},
       {"type", "T", "only records of type T", "obs"},
@@ -79,8 +79,7 @@ void save_pngs(const stream::Record& record, const std::string& dir, bool depth,
 }  // namespace
 
 static void run(const cli::Arguments& args) {
-  std::vector<std::string> files = args.positional();
-  if (files.empty()) files.push_back("-");
+  const std::vector<std::string> files = args.inputs();
   const std::string dir = args.text("dir"), type = args.text("type");
   const int64_t every = args.integer("every", 1, 1000000000);
   std::unique_ptr<video::EpisodeVideo> video;

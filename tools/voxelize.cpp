@@ -9,6 +9,7 @@
 #include "point_clouds/cloud_filters.hpp"
 #include "stream/reader.hpp"
 #include "stream/writer.hpp"
+#include "voxels/hierarchy_options.hpp"
 #include "voxels/voxel_image.hpp"
 #include "voxels/voxels_record.hpp"
 
@@ -37,17 +38,16 @@ static cli::Usage usage() {
       "With --png DIR a picture of every grid is saved (occupied voxels as cubes in their "
       "colour): the way to see what the attention sees.",
   };
-  u.arguments = {{"FILE", "input records; '-' or absent is standard input", true, false}};
+  u.arguments = {cli::input_file()};
   u.options = {
-      {"voxels", "V", "voxels per side of every grid", "16"},
-      {"bounds", "X,Y,Z,S", "scene bounds: minimum corner and edge length in metres", "-0.3,-0.5,0.6,1.0"},
       {"centre", "X,Y,Z", "also voxelize centre +- offset at depth 1 (repeat for several: one batched pass)", "", true},
       {"offset", "M", "half edge of the deeper grids, metres", "0.15"},
       {"octomap-channels", "", "add the free and unknown channels (12 in all)", ""},
       {"png", "DIR", "save a picture of every grid as DIR/<record>.depth<d>[.<k>].png", ""},
       {"output", "FILE", "where to write; '-' is standard output", "-"},
   };
-  for (auto& option : point_clouds::cloud_filter_options()) u.options.push_back(option);
+  u.add_options(voxels::scene_options());
+  u.add_options(point_clouds::cloud_filter_options());
   u.examples = {
       {"sim-step --task reach_target < /dev/null | voxelize --png grids/ | stream-dump --type voxels",
        "voxelize the first observation and look at it"},
@@ -59,8 +59,7 @@ static cli::Usage usage() {
 }
 
 static void run(const cli::Arguments& args) {
-  const voxels::GridBounds scene = voxels::GridBounds::parse(args.text("bounds"), static_cast<int>(args.integer("voxels", 2, 256)));
-  if (scene.voxels > 256) throw UsageError("--voxels must be 2-256");
+  const voxels::GridBounds scene = voxels::parse_scene(args);
   const double offset = args.real("offset", 0.001, 10);
   std::vector<voxels::GridBounds> crops;
   for (const auto& c : args.all("centre")) {
@@ -73,7 +72,7 @@ static void run(const cli::Arguments& args) {
   if (!png_dir.empty()) make_output_directory(png_dir);
 
   const std::size_t grid_floats = static_cast<std::size_t>(scene.voxels) * scene.voxels * scene.voxels * voxels::kChannels;
-  stream::RecordReader reader(args.positional().empty() ? "-" : args.positional()[0]);
+  stream::RecordReader reader(args.input());
   stream::RecordWriter writer(args.text("output"));
   while (auto record = reader.next()) {
     writer.write(*record);

@@ -31,7 +31,7 @@ static cli::Usage usage() {
       "motion and is skipped with a line on standard error. examples/xarm_play.py plays the "
       "files on the arm with UFACTORY's Python SDK.",
   };
-  u.arguments = {{"FILE", "record streams; '-' or absent is standard input", true, true}};
+  u.arguments = {cli::input_files("record streams")};
   u.options = {
       {"dir", "DIR", "where the files go (created if missing)", "."},
       {"rate", "HZ", "control rate of the rows (the xArm's servo mode takes up to 250 Hz)", "100"},
@@ -46,8 +46,7 @@ static cli::Usage usage() {
 }
 
 static void run(const cli::Arguments& args) {
-  std::vector<std::string> files = args.positional();
-  if (files.empty()) files.push_back("-");
+  const std::vector<std::string> files = args.inputs();
   const std::string dir = args.text("dir");
   const double rate = args.real("rate", 1, 1000), settle = args.real("settle", 0, 60);
   make_output_directory(dir);

@@ -63,6 +63,7 @@ std::string option_label(const OptionSpec& o) {
 
 std::string option_help(const OptionSpec& o) {
   std::string h = o.help;
+  if (o.required) h += " (required)";
   if (!o.default_value.empty()) h += " (default: " + o.default_value + ")";
   if (o.repeatable) h += "; may be repeated";
   return h;
@@ -107,6 +108,14 @@ const char* kCommonExitStatus =
     "standard output went away (as for SIGPIPE).";
 
 }  // namespace
+
+ArgumentSpec input_file(const std::string& what) {
+  return {"FILE", what + "; '-' or absent is standard input", true, false};
+}
+
+ArgumentSpec input_files(const std::string& what) {
+  return {"FILE", what + "; '-' or absent is standard input", true, true};
+}
 
 bool Arguments::has(const std::string& name) const { return given_.count(name) > 0; }
 
@@ -158,6 +167,16 @@ double Arguments::real(const std::string& name, double lo, double hi) const {
     throw UsageError("--" + name + " must be " + range.str() + ", got " + text(name));
   }
   return x;
+}
+
+std::size_t Arguments::choice(const std::string& name, const std::vector<std::string>& choices) const {
+  const std::string v = text(name);
+  std::string listed;
+  for (std::size_t i = 0; i < choices.size(); ++i) {
+    if (choices[i] == v) return i;
+    listed += (i == 0 ? "" : i + 1 == choices.size() ? " or " : ", ") + choices[i];
+  }
+  throw UsageError("--" + name + ": expected " + listed + ", got '" + v + "'");
 }
 
 std::vector<double> Arguments::reals(const std::string& name, std::size_t count) const {
@@ -224,6 +243,8 @@ Arguments parse(const Usage& usage, const std::vector<std::string>& argv) {
     values.push_back(value);
   }
   if (args.has("help") || args.has("help-man") || args.has("version")) return args;
+  for (const auto& o : options)
+    if (o.required && !args.has(o.name)) throw UsageError(option_label(o) + " is required");
   std::size_t required = 0, max = 0;
   bool unbounded = false;
   for (const auto& spec : usage.arguments) {

@@ -17,6 +17,7 @@ struct OptionSpec {
   std::string help;
   std::string default_value;  // shown in help; used when the option is absent
   bool repeatable = false;    // may be given several times (values collected in order)
+  bool required = false;      // parse() refuses a command line without it
 };
 
 struct ArgumentSpec {
@@ -25,6 +26,12 @@ struct ArgumentSpec {
   bool optional = false;
   bool variadic = false;  // takes the remaining arguments
 };
+
+// The record-stream input of a filter: one FILE, '-' or absent meaning standard input
+// (read with Arguments::input()).
+ArgumentSpec input_file(const std::string& what = "input records");
+// Streams read one after another; none means standard input (Arguments::inputs()).
+ArgumentSpec input_files(const std::string& what = "record streams to read in order");
 
 struct Example {
   std::string command;
@@ -42,6 +49,9 @@ struct Usage {
   // True when the tool draws random numbers; --seed is accepted by every tool either way.
   bool uses_randomness = false;
   std::string exit_status;  // extra text for EXIT STATUS; the common codes are always listed
+
+  // Appends an option group shared by several tools (e.g. voxels::hierarchy_options()).
+  void add_options(const std::vector<OptionSpec>& group) { options.insert(options.end(), group.begin(), group.end()); }
 };
 
 class Arguments {
@@ -55,10 +65,16 @@ class Arguments {
   double real(const std::string& name) const;
   // The same, refused with a UsageError unless finite and within lo..hi.
   double real(const std::string& name, double lo, double hi) const;
+  // The index of the option's value in `choices`, or a UsageError listing them.
+  std::size_t choice(const std::string& name, const std::vector<std::string>& choices) const;
   // Exactly `count` comma-separated finite numbers ("0.1,0,0.8"), or a UsageError naming the option.
   std::vector<double> reals(const std::string& name, std::size_t count) const;
   std::vector<std::string> all(const std::string& name) const;  // repeatable options
   const std::vector<std::string>& positional() const { return positional_; }
+  std::string input() const { return positional_.empty() ? "-" : positional_[0]; }
+  std::vector<std::string> inputs() const {
+    return positional_.empty() ? std::vector<std::string>{"-"} : positional_;
+  }
   uint64_t seed() const { return static_cast<uint64_t>(integer("seed")); }
 
  private:
@@ -71,7 +87,8 @@ class Arguments {
 // The list parser behind Arguments::reals, for values of repeatable options.
 std::vector<double> parse_reals(const std::string& option, const std::string& text, std::size_t count);
 
-// Throws UsageError on unknown options, missing values or wrong argument counts.
+// Throws UsageError on unknown options, missing values, missing required options or wrong
+// argument counts.
 Arguments parse(const Usage& usage, const std::vector<std::string>& argv);
 
 std::string help_text(const Usage& usage);

@@ -52,3 +52,32 @@ TEST(Command, HelpAndManPageCoverEveryOption) {
   EXPECT_NE(man.find(".TH DEMO-TOOL 1"), std::string::npos);
   EXPECT_NE(help.find("(default: 10)"), std::string::npos);
 }
+
+TEST(Command, RequiredOptionsChoicesAndInputs) {
+  cli::Usage u = usage();
+  u.arguments = {cli::input_files()};
+  u.add_options({{"checkpoint", "FILE", "networks", "", false, true}, {"band", "KIND", "std, ci or none", "std"}});
+  try {
+    cli::parse(u, {"x.rec"});
+    ADD_FAILURE() << "a missing required option was accepted";
+  } catch (const UsageError& e) {
+    EXPECT_STREQ(e.what(), "--checkpoint FILE is required");
+  }
+  EXPECT_NO_THROW(cli::parse(u, {"--help"}));  // help needs no required option
+  const auto a = cli::parse(u, {"--checkpoint", "c.rec", "--band", "none"});
+  EXPECT_EQ(a.inputs(), std::vector<std::string>{"-"});  // none given: standard input
+  EXPECT_EQ(a.input(), "-");
+  EXPECT_EQ(a.choice("band", {"std", "ci", "none"}), 2u);
+  try {
+    cli::parse(u, {"--checkpoint", "c", "--band", "sem"}).choice("band", {"std", "ci", "none"});
+    ADD_FAILURE() << "an unknown choice was accepted";
+  } catch (const UsageError& e) {
+    EXPECT_STREQ(e.what(), "--band: expected std, ci or none, got 'sem'");
+  }
+  const auto b = cli::parse(u, {"--checkpoint", "c", "a.rec", "b.rec"});
+  EXPECT_EQ(b.inputs(), (std::vector<std::string>{"a.rec", "b.rec"}));
+  EXPECT_EQ(b.input(), "a.rec");
+  const std::string help = cli::help_text(u);
+  EXPECT_NE(help.find("networks (required)"), std::string::npos);
+  EXPECT_NE(help.find("'-' or absent is standard input"), std::string::npos);
+}
