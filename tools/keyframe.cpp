@@ -75,15 +75,12 @@ static void run(const cli::Arguments& args) {
   if (args.flag("append")) write_options.mode = stream::WriteMode::append;
   stream::RecordReader reader(args.input());
   stream::RecordWriter writer(args.text("output"), write_options);
-  const auto emit = [&](const stream::Record& r) { writer.write(r); };
   const auto convert_all = [&](auto&& converter) {
-    while (auto record = reader.next()) converter.handle(*record);
-    converter.finish();
-    writer.close();
+    stream::run_stage(converter, reader, writer);
     std::cerr << "keyframe: " << converter.counts().summary() << "\n";
   };
-  if (args.flag("agent")) convert_all(keyframes::AgentEpisodeConverter(options, emit));
-  else convert_all(keyframes::EpisodeConverter(options, emit));
+  if (args.flag("agent")) convert_all(keyframes::AgentEpisodeConverter(options));
+  else convert_all(keyframes::EpisodeConverter(options));
 }
 
 int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }

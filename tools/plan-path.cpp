@@ -3,6 +3,7 @@
 #include "planning/motion_planner.hpp"
 #include "point_clouds/cloud_filters.hpp"
 #include "stream/reader.hpp"
+#include "stream/stage.hpp"
 #include "stream/writer.hpp"
 #include "world/scene_layout.hpp"
 
@@ -67,14 +68,10 @@ static void run(const cli::Arguments& args) {
   const robot::RobotModel robot = robot::RobotModel::xarm7();
   const Eigen::Isometry3d world_from_base = world::SceneLayout{}.robot_base_pose();
   planning::PlanPathFilter filter(robot, world_from_base, options);
-  const point_clouds::CloudFilters filters = point_clouds::parse_cloud_filters(args);
-  if (filters.any())
-    filter.observe_through([filters](const stream::Record& obs) { return point_clouds::filter_observation(obs, filters); });
+  filter.observe_through(point_clouds::observation_filter(point_clouds::parse_cloud_filters(args)));
   stream::RecordReader reader(args.input());
   stream::RecordWriter writer(args.text("output"));
-  while (auto record = reader.next())
-    filter.handle(*record, [&](const stream::Record& r) { writer.write(r); });
-  writer.close();
+  stream::run_stage(filter, reader, writer);
   if (args.has("octomap")) {
     if (!filter.last_scene()) throw Error("--octomap: no action was planned, so there is no scene map");
     filter.last_scene()->write_binary(args.text("octomap"));

@@ -1,26 +1,18 @@
 // qte-select: the acting agent. Observations in, next-best poses chosen by coarse-to-fine
 // Q-attention with tree expansion (C2F-ARM+QTE) out, with optional exploration.
 
-#include <cerrno>
 #include <cmath>
-#include <iostream>
-#include <optional>
-#include <random>
 
 #include "cli/command.hpp"
 #include "common/atomic_file.hpp"
-#include "common/random.hpp"
 #include "nets/qattention_net.hpp"
 #include "point_clouds/cloud_filters.hpp"
-#include "qattention/acting.hpp"
-#include "qattention/action_record.hpp"
 #include "qattention/branching_options.hpp"
-#include "qattention/proprio.hpp"
+#include "qattention/select_stage.hpp"
 #include "stream/reader.hpp"
+#include "stream/stage.hpp"
 #include "stream/writer.hpp"
-#include "voxels/grid_fields.hpp"
 #include "voxels/hierarchy_options.hpp"
-#include "voxels/observation_cloud.hpp"
 
 using namespace qte;
 
@@ -120,10 +112,6 @@ double non_negative(const cli::Arguments& args, const std::string& name) {
   return x;
 }
 
-}  // namespace
-
-namespace {
-
 qattention::Exploration exploration_from(const cli::Arguments& args) {
   qattention::Exploration exploration;
   exploration.epsilon = probability(args, "epsilon");
@@ -133,64 +121,29 @@ qattention::Exploration exploration_from(const cli::Arguments& args) {
   return exploration;
 }
 
-// One observation's action; an error of the networks (a diverged checkpoint) names the record.
-// The action's pictures read `observed` later: it must outlive the action.
-qattention::Action act_on(const stream::Record& obs, const voxels::ObservationCloud& observed, int32_t step,
-                          const qattention::DepthEvaluator& evaluate, const voxels::CoarseToFine& hierarchy,
-                          const qattention::Branching& branching, const qattention::Exploration& exploration,
-                          std::mt19937_64& rng, const std::string& checkpoint) {
-  const std::vector<float> proprio = qattention::proprio_of(obs, step);
-  for (float p : proprio)
-    if (!std::isfinite(p)) obs.fail("gripper_opening_m", "a finite gripper opening");
-  try {
-    return qattention::act(evaluate, hierarchy, observed.view(), proprio, branching, exploration, rng);
-  } catch (const StreamError&) {
-    throw;
-  } catch (const Error& e) {
-    throw StreamError(obs.position, std::string(e.what()) + " (checkpoint " + checkpoint + ")");
-  }
-}
-
 }  // namespace
 
 static void run(const cli::Arguments& args) {
   const std::string checkpoint = args.text("checkpoint");
-  const qattention::Branching branching = qattention::parse_branching(args, "k", 1);
-  const int64_t threads = args.integer("threads", 1, 256);
-  const qattention::Exploration exploration = exploration_from(args);
-  const bool ignore_collisions = args.flag("ignore-collisions"), reload = args.flag("reload");
-  const std::string png_dir = args.text("png");
-  const point_clouds::CloudFilters filters = point_clouds::parse_cloud_filters(args);
+  qattention::SelectOptions options;
+  options.branching = qattention::parse_branching(args, "k", 1);
+  options.exploration = exploration_from(args);
+  options.ignore_collisions = args.flag("ignore-collisions");
+  options.reload = args.flag("reload");
+  options.png_dir = args.text("png");
+  options.seed = args.seed();
+  options.prepare = point_clouds::observation_filter(point_clouds::parse_cloud_filters(args));
 
-  nets::set_torch_threads(static_cast<int>(threads));
+  nets::set_torch_threads(static_cast<int>(args.integer("threads", 1, 256)));
   qattention::CheckpointNetworks networks(checkpoint);
-  const voxels::CoarseToFine hierarchy = voxels::checkpoint_hierarchy(
-      args, networks.hierarchy(), networks.config().net.voxels, networks.config().depths, checkpoint);
-  if (!png_dir.empty()) make_output_directory(png_dir);
+  options.hierarchy = voxels::checkpoint_hierarchy(args, networks.hierarchy(), networks.config().net.voxels,
+                                                   networks.config().depths, checkpoint);
+  if (!options.png_dir.empty()) make_output_directory(options.png_dir);
 
-  const qattention::DepthEvaluator evaluate = qattention::network_evaluator(networks.nets());
+  qattention::SelectStage stage(networks, options);
   stream::RecordReader reader(args.input());
   stream::RecordWriter writer(args.text("output"));
-  uint64_t actions = 0;
-  while (auto record = reader.next()) {
-    writer.write(*record);
-    if (record->type() != "obs") continue;
-    if (record->has("terminal") && record->scalar<uint8_t>("terminal") != 0) continue;
-    const int32_t step = record->scalar<int32_t>("step");
-    if (reload && step == 0 && networks.reload_if_changed())
-      std::cerr << "qte-select: loaded checkpoint " << checkpoint << " at training step " << networks.step()
-                << std::endl;
-    std::mt19937_64 rng(derive_seed(args.seed(), actions));
-    const voxels::ObservationCloud observed =
-        voxels::observation_cloud(filters.any() ? point_clouds::filter_observation(*record, filters) : *record);
-    qattention::Action action =  // not const: its pictures compute the grids they show lazily
-        act_on(*record, observed, step, evaluate, hierarchy, branching, exploration, rng, checkpoint);
-    if (!png_dir.empty()) qattention::save_q_pictures(png_dir, actions, action);
-    writer.write(qattention::action_record(action.choice, ignore_collisions, branching.k, action.explored,
-                                           networks.step(), step));
-    actions += 1;
-  }
-  writer.close();
+  stream::run_stage(stage, reader, writer);
 }
 
 int main(int argc, char** argv) {

@@ -74,8 +74,9 @@ static void run(const cli::Arguments& args) {
   const std::string input = args.input();
   std::unique_ptr<stream::RecordReader> reader;
   stream::RecordWriter writer(args.text("output"));
-  sim_step::run_filter(
-      simulator, plan,
+  sim_step::SimStep stage(simulator, plan);
+  stream::run_stage(
+      stage,
       [&]() -> std::optional<stream::Record> {
         // Opened on demand: opening a FIFO blocks until its writer appears, and in the actor
         // loop that writer waits for our first observation.

@@ -1,16 +1,12 @@
 // voxelize: observations to coarse-to-fine voxel grids (C2F-ARM's 10 channels).
 
-#include <cmath>
-#include <cstdio>
-#include <sstream>
-
 #include "cli/command.hpp"
 #include "common/atomic_file.hpp"
 #include "point_clouds/cloud_filters.hpp"
 #include "stream/reader.hpp"
+#include "stream/stage.hpp"
 #include "stream/writer.hpp"
 #include "voxels/hierarchy_options.hpp"
-#include "voxels/voxel_image.hpp"
 #include "voxels/voxels_record.hpp"
 
 using namespace qte;
@@ -66,30 +62,14 @@ static void run(const cli::Arguments& args) {
     const auto p = cli::parse_reals("centre", c, 3);
     crops.push_back(voxels::GridBounds::around({p[0], p[1], p[2]}, offset, scene.voxels));
   }
-  const bool octomap_channels = args.flag("octomap-channels");
-  const point_clouds::CloudFilters filters = point_clouds::parse_cloud_filters(args);
   const std::string png_dir = args.text("png");
   if (!png_dir.empty()) make_output_directory(png_dir);
 
-  const std::size_t grid_floats = static_cast<std::size_t>(scene.voxels) * scene.voxels * scene.voxels * voxels::kChannels;
+  voxels::VoxelizeStage stage({scene, crops, args.flag("octomap-channels")}, png_dir,
+                              point_clouds::observation_filter(point_clouds::parse_cloud_filters(args)));
   stream::RecordReader reader(args.input());
   stream::RecordWriter writer(args.text("output"));
-  while (auto record = reader.next()) {
-    writer.write(*record);
-    if (record->type() != "obs") continue;
-    const voxels::VoxelsOfObservation out = voxels::voxels_of(
-        filters.any() ? point_clouds::filter_observation(*record, filters) : *record, {scene, crops, octomap_channels});
-    if (!png_dir.empty()) {
-      char index[16];
-      std::snprintf(index, sizeof index, "%06llu", static_cast<unsigned long long>(record->position.record_index));
-      voxels::save_voxel_png(png_dir + "/" + index + ".depth0.png", out.grids.data(), scene.voxels);
-      for (std::size_t c = 0; c < crops.size(); ++c)
-        voxels::save_voxel_png(png_dir + "/" + index + ".depth1." + std::to_string(c) + ".png",
-                               out.grids.data() + (1 + c) * grid_floats, scene.voxels);
-    }
-    writer.write(out.record);
-  }
-  writer.close();
+  stream::run_stage(stage, reader, writer);
 }
 
 int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }

@@ -58,14 +58,13 @@ std::string ConversionCounts::summary() const {
   return s;
 }
 
-AgentEpisodeConverter::AgentEpisodeConverter(TransitionOptions options, std::function<void(const stream::Record&)> emit)
-    : options_(std::move(options)), emit_(std::move(emit)) {}
+AgentEpisodeConverter::AgentEpisodeConverter(TransitionOptions options) : options_(std::move(options)) {}
 
-void AgentEpisodeConverter::handle(const stream::Record& record) {
+void AgentEpisodeConverter::handle(const stream::Record& record, const stream::Emit& emit) {
   if (record.type() == "obs") {
-    if (!observations_.empty() && record.scalar<int32_t>("step") == 0) convert();  // a new episode
+    if (!observations_.empty() && record.scalar<int32_t>("step") == 0) convert(emit);  // a new episode
     observations_.push_back(record);
-    if (record.scalar<uint8_t>("terminal") != 0) convert();
+    if (record.scalar<uint8_t>("terminal") != 0) convert(emit);
   } else if (record.type() == "action" && !observations_.empty()) {
     if (actions_.size() + 1 != observations_.size())
       throw StreamError(record.position, "'action' record without an observation of its own before it");
@@ -73,11 +72,11 @@ void AgentEpisodeConverter::handle(const stream::Record& record) {
   }
 }
 
-void AgentEpisodeConverter::finish() {
-  if (!observations_.empty()) convert();  // unfinished: its complete steps are still experience
+void AgentEpisodeConverter::finish(const stream::Emit& emit) {
+  if (!observations_.empty()) convert(emit);  // unfinished: its complete steps are still experience
 }
 
-void AgentEpisodeConverter::convert() {
+void AgentEpisodeConverter::convert(const stream::Emit& emit) {
   counts_.episodes += 1;
   const std::size_t steps = std::min(actions_.size(), observations_.size() - 1);
   if (steps == 0) {
@@ -118,10 +117,10 @@ void AgentEpisodeConverter::convert() {
       r.set_scalar<float>("reward", next.scalar<float>("reward"));
       r.set_scalar<uint8_t>("terminal", next.scalar<uint8_t>("terminal"));
       r.set_scalar<uint8_t>("demo", 0);
-      if (t == 0) emit_(frame_record(obs, episode_key));
-      emit_(frame_record(next, episode_key));
+      if (t == 0) emit(frame_record(obs, episode_key));
+      emit(frame_record(next, episode_key));
       counts_.frames += t == 0 ? 2 : 1;
-      emit_(r);
+      emit(r);
       counts_.transitions += 1;
     }
     counts_.converted += 1;
@@ -152,24 +151,23 @@ stream::Record frame_record(const stream::Record& obs, int64_t episode_key) {
   return frame;
 }
 
-EpisodeConverter::EpisodeConverter(TransitionOptions options, std::function<void(const stream::Record&)> emit)
-    : options_(std::move(options)), emit_(std::move(emit)), rng_(options_.seed) {}
+EpisodeConverter::EpisodeConverter(TransitionOptions options) : options_(std::move(options)), rng_(options_.seed) {}
 
-void EpisodeConverter::handle(const stream::Record& record) {
+void EpisodeConverter::handle(const stream::Record& record, const stream::Emit& emit) {
   if (record.type() == "episode") {
-    convert(episode_, &record);
+    convert(episode_, &record, emit);
     episode_.clear();
   } else if (record.type() == "obs") {
     if (!episode_.empty() && record.scalar<int32_t>("frame") == 0) {
-      convert(episode_, nullptr);
+      convert(episode_, nullptr, emit);
       episode_.clear();
     }
     episode_.push_back(record);
   }
 }
 
-void EpisodeConverter::finish() {
-  if (!episode_.empty()) convert(episode_, nullptr);
+void EpisodeConverter::finish(const stream::Emit& emit) {
+  if (!episode_.empty()) convert(episode_, nullptr, emit);
   episode_.clear();
 }
 
@@ -212,7 +210,8 @@ std::vector<int> EpisodeConverter::usable_keyframes(const std::vector<stream::Re
   return keyframes;
 }
 
-void EpisodeConverter::convert(std::vector<stream::Record>& episode, const stream::Record* summary) {
+void EpisodeConverter::convert(std::vector<stream::Record>& episode, const stream::Record* summary,
+                               const stream::Emit& emit) {
   counts_.episodes += 1;
   bool success = false;
   const std::vector<int> keyframes = usable_keyframes(episode, summary, success);
@@ -227,7 +226,7 @@ void EpisodeConverter::convert(std::vector<stream::Record>& episode, const strea
   std::set<int> stored;
   auto store = [&](int i) {
     if (stored.insert(i).second) {
-      emit_(frame_record(episode[i], episode_key));
+      emit(frame_record(episode[i], episode_key));
       counts_.frames += 1;
     }
   };
@@ -238,7 +237,7 @@ void EpisodeConverter::convert(std::vector<stream::Record>& episode, const strea
       const stream::Record t = transition(episode, previous, k, step, episode_key, k == keyframes.back(), success);
       store(previous);
       store(k);
-      emit_(t);
+      emit(t);
       counts_.transitions += 1;
       previous = k;
       ++step;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "stream/record.hpp"
+#include "stream/stage.hpp"
 #include "voxels/voxel_grid.hpp"
 
 namespace qte::keyframes {
@@ -36,14 +37,14 @@ struct ConversionCounts {
   std::string summary() const;
 };
 
-class EpisodeConverter {
+class EpisodeConverter : public stream::Stage {
  public:
-  EpisodeConverter(TransitionOptions options, std::function<void(const stream::Record&)> emit);
+  explicit EpisodeConverter(TransitionOptions options);
 
   // Feed a demonstration stream record by record: obs records gather into an episode, which
   // ends at an 'episode' record or at an obs with frame 0; finish() converts the last one.
-  void handle(const stream::Record& record);
-  void finish();
+  void handle(const stream::Record& record, const stream::Emit& emit) override;
+  void finish(const stream::Emit& emit) override;
   const ConversionCounts& counts() const { return counts_; }
 
  private:
@@ -51,12 +52,11 @@ class EpisodeConverter {
   // episode is skipped, the reason counted), then each transition of its chains.
   std::vector<int> usable_keyframes(const std::vector<stream::Record>& episode, const stream::Record* summary,
                                     bool& success);
-  void convert(std::vector<stream::Record>& episode, const stream::Record* summary);
+  void convert(std::vector<stream::Record>& episode, const stream::Record* summary, const stream::Emit& emit);
   stream::Record transition(const std::vector<stream::Record>& episode, int from, int to, int step, int64_t episode_key,
                             bool last, bool success);
 
   TransitionOptions options_;
-  std::function<void(const stream::Record&)> emit_;
   std::vector<stream::Record> episode_;
   ConversionCounts counts_;
   std::mt19937_64 rng_;
@@ -68,18 +68,17 @@ class EpisodeConverter {
 // and terminal flag. The action's own per-depth indices and bounds are kept as chosen (so
 // exploration is learned from as it happened). Unsuccessful episodes are kept: they are the
 // agent's experience. Episodes end at a terminal observation or at an obs with step 0.
-class AgentEpisodeConverter {
+class AgentEpisodeConverter : public stream::Stage {
  public:
-  AgentEpisodeConverter(TransitionOptions options, std::function<void(const stream::Record&)> emit);
-  void handle(const stream::Record& record);
-  void finish();
+  explicit AgentEpisodeConverter(TransitionOptions options);
+  void handle(const stream::Record& record, const stream::Emit& emit) override;
+  void finish(const stream::Emit& emit) override;
   const ConversionCounts& counts() const { return counts_; }
 
  private:
-  void convert();
+  void convert(const stream::Emit& emit);
 
   TransitionOptions options_;
-  std::function<void(const stream::Record&)> emit_;
   std::vector<stream::Record> observations_, actions_;  // actions_[t] was chosen for observations_[t]
   ConversionCounts counts_;
 };

@@ -279,8 +279,7 @@ PlanPathFilter::PlanPathFilter(const robot::RobotModel& robot, const Eigen::Isom
                                PlannerOptions options)
     : planner_(robot, world_from_base, options) {}
 
-void PlanPathFilter::handle(const stream::Record& record,
-                            const std::function<void(const stream::Record&)>& emit) {
+void PlanPathFilter::handle(const stream::Record& record, const stream::Emit& emit) {
   emit(record);
   if (record.type() == "obs") {
     obs_ = prepare_ ? prepare_(record) : record;

@@ -19,6 +19,7 @@
 #include "world/scene_layout.hpp"
 #include "robot/inverse_kinematics.hpp"
 #include "stream/record.hpp"
+#include "stream/stage.hpp"
 
 namespace qte::planning {
 
@@ -103,10 +104,10 @@ class MotionPlanner {
 
 // plan-path as a library: observations pass through and are remembered; each action passes
 // through followed by its trajectory (or failure); other records pass through.
-class PlanPathFilter {
+class PlanPathFilter : public stream::Stage {
  public:
   PlanPathFilter(const robot::RobotModel& robot, const Eigen::Isometry3d& world_from_base, PlannerOptions options);
-  void handle(const stream::Record& record, const std::function<void(const stream::Record&)>& emit);
+  void handle(const stream::Record& record, const stream::Emit& emit) override;
   // Plans on what `prepare` makes of each observation (point-cloud filters) instead of the
   // observation itself; records still pass through unchanged.
   void observe_through(std::function<stream::Record(const stream::Record&)> prepare) { prepare_ = std::move(prepare); }

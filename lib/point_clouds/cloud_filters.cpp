@@ -136,4 +136,9 @@ stream::Record filter_observation(const stream::Record& obs, const CloudFilters&
   return out;
 }
 
+ObservationFilter observation_filter(const CloudFilters& filters) {
+  if (!filters.any()) return nullptr;
+  return [filters](const stream::Record& obs) { return filter_observation(obs, filters); };
+}
+
 }  // namespace qte::point_clouds

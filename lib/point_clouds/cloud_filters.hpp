@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -35,5 +36,10 @@ voxels::ObservationCloud filter_cloud(const voxels::ObservationCloud& cloud, con
 // dropped since they no longer match it; intrinsics, extrinsics and everything else kept.
 // Tools use it in place of the record and pass the original on.
 stream::Record filter_observation(const stream::Record& obs, const CloudFilters& filters);
+
+// What the stages that read observations (voxelize, qte-select, plan-path) make of each one
+// before using it: filter_observation with `filters`; nothing (use it as it is) without any.
+using ObservationFilter = std::function<stream::Record(const stream::Record&)>;
+ObservationFilter observation_filter(const CloudFilters& filters);
 
 }  // namespace qte::point_clouds

@@ -242,6 +242,20 @@ void choose_ticks(Plot& plot, const Style& style) {
   set_ticks(plot.y, y_tick_target(plot.area.height, style));
 }
 
+// A title wider than the picture is drawn smaller, never cut off; it is centred on the data
+// area as far as the picture's edges allow.
+void draw_title(cv::Mat& image, const std::string& title, const Plot& plot, const Style& style, int gap) {
+  const int room = image.cols - 2 * gap;
+  double title_scale = style.title_scale;
+  cv::Size s = text_size(title, title_scale, style.thickness);
+  if (s.width > room) {
+    title_scale *= 0.98 * room / s.width;
+    s = text_size(title, title_scale, style.thickness);
+  }
+  const int centre = std::max(gap + s.width / 2, std::min(plot.area.x + plot.area.width / 2, image.cols - gap - s.width / 2));
+  draw_text(image, title, {centre - s.width / 2, gap * 2}, title_scale, style.thickness, kInk);
+}
+
 cv::Mat draw(const std::vector<Curve>& curves, Axis x_axis, Axis y_axis, const Labels& labels, cv::Size size) {
   const double scale = std::clamp(std::min(size.width / 800.0, size.height / 500.0), 0.6, 3.0);
   Style style{scale, 0.42 * scale, 0.5 * scale, 0.62 * scale, std::max(1, static_cast<int>(std::lround(scale))),
@@ -306,19 +320,7 @@ cv::Mat draw(const std::vector<Curve>& curves, Axis x_axis, Axis y_axis, const L
   if (!labels.y.empty())
     draw_text_upwards(image, labels.y, {gap + label_height / 2, plot.area.y + plot.area.height / 2},
                       style.label_scale, style.thickness, kInk);
-  if (!labels.title.empty()) {
-    // A title wider than the picture is drawn smaller, never cut off; it is centred on the
-    // data area as far as the picture's edges allow.
-    const int room = size.width - 2 * gap;
-    double title_scale = style.title_scale;
-    cv::Size s = text_size(labels.title, title_scale, style.thickness);
-    if (s.width > room) {
-      title_scale *= 0.98 * room / s.width;
-      s = text_size(labels.title, title_scale, style.thickness);
-    }
-    const int centre = std::max(gap + s.width / 2, std::min(plot.area.x + plot.area.width / 2, size.width - gap - s.width / 2));
-    draw_text(image, labels.title, {centre - s.width / 2, gap * 2}, title_scale, style.thickness, kInk);
-  }
+  if (!labels.title.empty()) draw_title(image, labels.title, plot, style, gap);
   if (labels.legend) draw_legend(image, plot, curves, style);
   return image;
 }

@@ -37,13 +37,58 @@ bool file_exists(const std::string& path) { return std::ifstream(path).good(); }
 
 std::string default_data_dir() {
   if (const char* env = std::getenv("QTE_DATA_DIR")) return env;
-  for (const std::string dir : {std::string(QTE_SOURCE_DATA_DIR), std::string(QTE_INSTALLED_DATA_DIR)})
+  for (const std::string& dir : {std::string(QTE_SOURCE_DATA_DIR), std::string(QTE_INSTALLED_DATA_DIR)})
     if (!dir.empty() && file_exists(dir + "/xarm7.urdf")) return dir;
   throw Error("cannot find the robot description xarm7.urdf: set QTE_DATA_DIR to the directory "
               "that holds it");
 }
 
 RobotModel RobotModel::xarm7() { return load_urdf(default_data_dir() + "/xarm7.urdf"); }
+
+namespace {
+
+// One collision element of a link: a box, cylinder or sphere placed in the link's frame.
+Shape shape_from(const urdf::Collision& collision, const std::string& path, const std::string& link) {
+  Shape shape;
+  shape.link_from_shape = to_eigen(collision.origin);
+  const auto& g = collision.geometry;
+  if (g->type == urdf::Geometry::BOX) {
+    auto box = std::static_pointer_cast<urdf::Box>(g);
+    shape.kind = Shape::Kind::box;
+    shape.size << box->dim.x, box->dim.y, box->dim.z;
+  } else if (g->type == urdf::Geometry::CYLINDER) {
+    auto c = std::static_pointer_cast<urdf::Cylinder>(g);
+    shape.kind = Shape::Kind::cylinder;
+    shape.size << c->radius, c->length, 0;
+  } else if (g->type == urdf::Geometry::SPHERE) {
+    shape.kind = Shape::Kind::sphere;
+    shape.size << std::static_pointer_cast<urdf::Sphere>(g)->radius, 0, 0;
+  } else {
+    throw Error(path + ": link " + link + ": only box, cylinder and sphere collision shapes are supported");
+  }
+  return shape;
+}
+
+// A joint's type, origin in its parent link, axis and limits (its links are set by the caller).
+Joint joint_from(const urdf::Joint& joint, const std::string& path) {
+  Joint j;
+  j.name = joint.name;
+  j.origin = to_eigen(joint.parent_to_joint_origin_transform);
+  j.axis << joint.axis.x, joint.axis.y, joint.axis.z;
+  if (joint.type == urdf::Joint::REVOLUTE) j.type = Joint::Type::revolute;
+  else if (joint.type == urdf::Joint::PRISMATIC) j.type = Joint::Type::prismatic;
+  else if (joint.type == urdf::Joint::FIXED) j.type = Joint::Type::fixed;
+  else throw Error(path + ": joint " + j.name + ": unsupported joint type");
+  if (joint.limits) {
+    j.lower = joint.limits->lower;
+    j.upper = joint.limits->upper;
+    j.max_velocity = joint.limits->velocity;
+  }
+  j.finger = j.type == Joint::Type::prismatic && j.name.find("finger") != std::string::npos;
+  return j;
+}
+
+}  // namespace
 
 RobotModel RobotModel::load_urdf(const std::string& path) {
   std::ifstream in(path);
@@ -61,27 +106,7 @@ RobotModel RobotModel::load_urdf(const std::string& path) {
         Link out;
         out.name = link->name;
         out.parent_joint = parent_joint;
-        for (const auto& collision : link->collision_array) {
-          Shape shape;
-          shape.link_from_shape = to_eigen(collision->origin);
-          const auto& g = collision->geometry;
-          if (g->type == urdf::Geometry::BOX) {
-            auto box = std::static_pointer_cast<urdf::Box>(g);
-            shape.kind = Shape::Kind::box;
-            shape.size << box->dim.x, box->dim.y, box->dim.z;
-          } else if (g->type == urdf::Geometry::CYLINDER) {
-            auto c = std::static_pointer_cast<urdf::Cylinder>(g);
-            shape.kind = Shape::Kind::cylinder;
-            shape.size << c->radius, c->length, 0;
-          } else if (g->type == urdf::Geometry::SPHERE) {
-            shape.kind = Shape::Kind::sphere;
-            shape.size << std::static_pointer_cast<urdf::Sphere>(g)->radius, 0, 0;
-          } else {
-            throw Error(path + ": link " + link->name +
-                        ": only box, cylinder and sphere collision shapes are supported");
-          }
-          out.shapes.push_back(shape);
-        }
+        for (const auto& collision : link->collision_array) out.shapes.push_back(shape_from(*collision, path, link->name));
         if (link->visual && link->visual->material)
           out.colour << link->visual->material->color.r, link->visual->material->color.g,
               link->visual->material->color.b;
@@ -89,21 +114,8 @@ RobotModel RobotModel::load_urdf(const std::string& path) {
         link_ids[out.name] = id;
         model.links_.push_back(out);
         for (const auto& child_joint : link->child_joints) {
-          Joint j;
-          j.name = child_joint->name;
+          Joint j = joint_from(*child_joint, path);
           j.parent_link = id;
-          j.origin = to_eigen(child_joint->parent_to_joint_origin_transform);
-          j.axis << child_joint->axis.x, child_joint->axis.y, child_joint->axis.z;
-          if (child_joint->type == urdf::Joint::REVOLUTE) j.type = Joint::Type::revolute;
-          else if (child_joint->type == urdf::Joint::PRISMATIC) j.type = Joint::Type::prismatic;
-          else if (child_joint->type == urdf::Joint::FIXED) j.type = Joint::Type::fixed;
-          else throw Error(path + ": joint " + j.name + ": unsupported joint type");
-          if (child_joint->limits) {
-            j.lower = child_joint->limits->lower;
-            j.upper = child_joint->limits->upper;
-            j.max_velocity = child_joint->limits->velocity;
-          }
-          j.finger = j.type == Joint::Type::prismatic && j.name.find("finger") != std::string::npos;
           const int joint_id = static_cast<int>(model.joints_.size());
           model.joints_.push_back(j);
           const auto child = urdf->getLink(child_joint->child_link_name);

@@ -113,14 +113,12 @@ stream::Record Simulator::observe(const std::string& failure) {
   return obs;
 }
 
-void Simulator::handle(const stream::Record& record,
-                       const std::function<void(const stream::Record&)>& emit) {
+void Simulator::handle(const stream::Record& record, const stream::Emit& emit) {
   if (record.type() == "reset") reset(record, emit);
   else if (record.type() == "trajectory") execute(record, emit);
 }
 
-void Simulator::reset(const stream::Record& record,
-                      const std::function<void(const stream::Record&)>& emit) {
+void Simulator::reset(const stream::Record& record, const stream::Emit& emit) {
   task_name_ = record.string("task");
   try {
     task_ = tasks::make_task(task_name_);
@@ -161,8 +159,7 @@ std::string Simulator::check_trajectory(const stream::Record& record) const {
   return robot::joint_path_failure(times.data, joints.data, n, robot_, limits);
 }
 
-void Simulator::execute(const stream::Record& record,
-                        const std::function<void(const stream::Record&)>& emit) {
+void Simulator::execute(const stream::Record& record, const stream::Emit& emit) {
   if (!world_) throw StreamError(record.position, "trajectory before any reset: expected a reset record first");
   if (terminal_)
     throw StreamError(record.position, "trajectory after the episode ended: expected a reset record");
@@ -254,20 +251,16 @@ stream::Record plan_reset(const EpisodePlan& plan, int index) {
   return reset;
 }
 
-void run_filter(Simulator& simulator, const std::optional<EpisodePlan>& plan,
-                const std::function<std::optional<stream::Record>()>& next_input,
-                const std::function<void(const stream::Record&)>& emit) {
-  int started = 0;
-  if (plan) simulator.handle(plan_reset(*plan, started++), emit);
-  while (!plan || !simulator.episode_over() || started < plan->episodes) {
-    if (plan && simulator.episode_over()) {
-      simulator.handle(plan_reset(*plan, started++), emit);
-      continue;
-    }
-    auto record = next_input();
-    if (!record) break;
-    simulator.handle(*record, emit);
-  }
+void SimStep::start(const stream::Emit& emit) { start_episodes_due(emit); }
+
+void SimStep::handle(const stream::Record& record, const stream::Emit& emit) {
+  simulator_.handle(record, emit);
+  start_episodes_due(emit);
+}
+
+void SimStep::start_episodes_due(const stream::Emit& emit) {
+  while (plan_ && simulator_.episode_over() && started_ < plan_->episodes)
+    simulator_.handle(plan_reset(*plan_, started_++), emit);
 }
 
 }  // namespace qte::sim_step

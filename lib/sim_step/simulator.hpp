@@ -15,6 +15,7 @@
 #include "robot/robot_model.hpp"
 #include "world/world.hpp"
 #include "stream/record.hpp"
+#include "stream/stage.hpp"
 #include "tasks/task.hpp"
 
 namespace qte::sim_step {
@@ -44,15 +45,15 @@ SimulatorOptions options_from_camera_arguments(const std::string& cameras, const
 Eigen::Isometry3d camera_pose(const std::string& name, const world::World& world);
 std::vector<std::string> camera_names();
 
-class Simulator {
+class Simulator : public stream::Stage {
  public:
   Simulator(const robot::RobotModel& robot, SimulatorOptions options);
-  ~Simulator();
+  ~Simulator() override;
 
   // Consumes one record; `emit` receives each observation produced. Records other than
   // reset and trajectory produce nothing. Protocol errors (a trajectory before any reset,
   // or after the episode ended) throw StreamError naming the record.
-  void handle(const stream::Record& record, const std::function<void(const stream::Record&)>& emit);
+  void handle(const stream::Record& record, const stream::Emit& emit) override;
 
   bool episode_over() const { return terminal_; }
 
@@ -62,8 +63,8 @@ class Simulator {
 
  private:
   stream::Record observe(const std::string& failure = "");
-  void reset(const stream::Record& record, const std::function<void(const stream::Record&)>& emit);
-  void execute(const stream::Record& record, const std::function<void(const stream::Record&)>& emit);
+  void reset(const stream::Record& record, const stream::Emit& emit);
+  void execute(const stream::Record& record, const stream::Emit& emit);
   std::string check_trajectory(const stream::Record& record) const;
 
   const robot::RobotModel& robot_;
@@ -106,11 +107,22 @@ struct EpisodePlan {
 // and index).
 stream::Record plan_reset(const EpisodePlan& plan, int index);
 
-// The sim-step filter: with a plan, starts its first episode at once and the next one after
-// each terminal observation, stopping after plan.episodes; records read from `next_input`
-// (until it returns nothing) drive the episodes. Observations go to `emit`.
-void run_filter(Simulator& simulator, const std::optional<EpisodePlan>& plan,
-                const std::function<std::optional<stream::Record>()>& next_input,
-                const std::function<void(const stream::Record&)>& emit);
+// The sim-step stage: the simulator driven by the records it reads and, with a plan, by
+// itself: its first episode starts before any input (in the actor loop the input is made from
+// that first observation), the next one after each terminal observation, and the stage is
+// done after plan.episodes.
+class SimStep : public stream::Stage {
+ public:
+  SimStep(Simulator& simulator, std::optional<EpisodePlan> plan) : simulator_(simulator), plan_(std::move(plan)) {}
+  void start(const stream::Emit& emit) override;
+  void handle(const stream::Record& record, const stream::Emit& emit) override;
+  bool done() const override { return plan_ && simulator_.episode_over() && started_ >= plan_->episodes; }
+
+ private:
+  void start_episodes_due(const stream::Emit& emit);
+  Simulator& simulator_;
+  std::optional<EpisodePlan> plan_;
+  int started_ = 0;
+};
 
 }  // namespace qte::sim_step

@@ -4,6 +4,7 @@
 #include <zstd.h>
 
 #include <cstring>
+#include <functional>
 #include <limits>
 
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
@@ -107,6 +108,37 @@ RecordHeader decode_header(const uint8_t* h, uint64_t max_payload_bytes,
   return header;
 }
 
+namespace {
+
+// A zstd-encoded field's data, checked to hold exactly one frame of the size its shape needs
+// (`raw_bytes`), decompressed into 64-byte-aligned memory. `what` prefixes the errors.
+std::shared_ptr<uint8_t> decompressed(const uint8_t* data, uint64_t stored, uint64_t raw_bytes, uint64_t max_field_bytes,
+                                      const std::string& what,
+                                      const std::function<StreamError(const std::string&)>& bad) {
+  if (raw_bytes > max_field_bytes)
+    throw bad(what + "decompressed size " + std::to_string(raw_bytes) + " exceeds the limit of " +
+              std::to_string(max_field_bytes));
+  const unsigned long long content = ZSTD_getFrameContentSize(data, stored);
+  if (content >= ZSTD_CONTENTSIZE_ERROR)
+    throw bad(what + "zstd frame without a content size (expected " + std::to_string(raw_bytes) + " bytes)");
+  if (content != raw_bytes)
+    throw bad(what + "zstd frame declares " + std::to_string(content) + " bytes, shape needs " +
+              std::to_string(raw_bytes));
+  if (ZSTD_findFrameCompressedSize(data, stored) != stored)
+    throw bad(what + "expected exactly one zstd frame in " + std::to_string(stored) + " bytes");
+  const std::size_t padded = pad64(raw_bytes ? raw_bytes : 1);
+  auto* out = static_cast<uint8_t*>(std::aligned_alloc(kAlignment, padded));
+  if (!out) throw std::bad_alloc();
+  std::shared_ptr<uint8_t> owner(out, [](uint8_t* q) { std::free(q); });
+  const std::size_t got = ZSTD_decompress(out, padded, data, stored);
+  if (ZSTD_isError(got) || got != raw_bytes)
+    throw bad(what + "zstd data does not decompress to " + std::to_string(raw_bytes) + " bytes" +
+              (ZSTD_isError(got) ? std::string(" (") + ZSTD_getErrorName(got) + ")" : ""));
+  return owner;
+}
+
+}  // namespace
+
 Record decode_payload(const RecordHeader& header, std::shared_ptr<const uint8_t> payload,
                       uint64_t max_field_bytes, const StreamPosition& where) {
   const uint8_t* base = payload.get();
@@ -169,29 +201,9 @@ Record decode_payload(const RecordHeader& header, std::shared_ptr<const uint8_t>
                   " bytes, stored " + std::to_string(stored));
       record.add(Field(name, dtype, shape, payload, data));
     } else {
-      if (raw_bytes > max_field_bytes)
-        throw bad("'" + name + "': decompressed size " + std::to_string(raw_bytes) +
-                  " exceeds the limit of " + std::to_string(max_field_bytes));
-      const unsigned long long content = ZSTD_getFrameContentSize(data, stored);
-      if (content >= ZSTD_CONTENTSIZE_ERROR)
-        throw bad("'" + name + "': zstd frame without a content size (expected " +
-                  std::to_string(raw_bytes) + " bytes)");
-      if (content != raw_bytes)
-        throw bad("'" + name + "': zstd frame declares " + std::to_string(content) +
-                  " bytes, shape needs " + std::to_string(raw_bytes));
-      if (ZSTD_findFrameCompressedSize(data, stored) != stored)
-        throw bad("'" + name + "': expected exactly one zstd frame in " + std::to_string(stored) +
-                  " bytes");
-      const std::size_t padded = pad64(raw_bytes ? raw_bytes : 1);
-      auto* out = static_cast<uint8_t*>(std::aligned_alloc(kAlignment, padded));
-      if (!out) throw std::bad_alloc();
-      std::shared_ptr<uint8_t> owner(out, [](uint8_t* q) { std::free(q); });
-      const std::size_t got = ZSTD_decompress(out, padded, data, stored);
-      if (ZSTD_isError(got) || got != raw_bytes)
-        throw bad("'" + name + "': zstd data does not decompress to " +
-                  std::to_string(raw_bytes) + " bytes" +
-                  (ZSTD_isError(got) ? std::string(" (") + ZSTD_getErrorName(got) + ")" : ""));
-      Field field(name, dtype, shape, owner, out);
+      const std::shared_ptr<uint8_t> owner =
+          decompressed(data, stored, raw_bytes, max_field_bytes, "'" + name + "': ", bad);
+      Field field(name, dtype, shape, owner, owner.get());
       field.compress = true;  // written again compressed when passed through
       record.add(std::move(field));
     }

@@ -35,6 +35,33 @@ void write_npy(const std::string& path, const Field& field) {
   write_file_atomically(path, bytes.data(), bytes.size());
 }
 
+namespace {
+
+// The shape tuple of a .npy header ("2, 3" or "4," or ""). Each dimension a non-negative
+// integer, and the element count within what a record holds: (-1,) is not [1], and
+// (2^32, 2^32, 4) does not wrap to a small array.
+Shape npy_shape(const std::string& dims, const std::string& path) {
+  auto bad = [&](const std::string& what) { return Error(path + ": " + what); };
+  Shape shape;
+  const std::regex item("\\s*([^,]*?)\\s*(,|$)");
+  double elements = 1;
+  for (std::sregex_iterator it(dims.begin(), dims.end(), item), end; it != end; ++it) {
+    const std::string dim = (*it)[1];
+    if (dim.empty()) {
+      if ((*it)[2].length() == 0) break;  // the end (after a trailing comma)
+      throw bad("shape (" + dims + "): an empty dimension");
+    }
+    if (!std::regex_match(dim, std::regex("\\d{1,15}"))) throw bad("shape (" + dims + "): '" + dim + "' is not a size");
+    shape.push_back(std::stoll(dim));
+    elements *= static_cast<double>(shape.back());
+    if (shape.size() > static_cast<std::size_t>(kMaxDims)) throw bad("shape (" + dims + "): more than 8 dimensions");
+  }
+  if (elements > 1e12) throw bad("shape (" + dims + ") is larger than a record field can hold");
+  return shape;
+}
+
+}  // namespace
+
 void read_npy_into(Record& record, const std::string& name, const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error("cannot open " + path);
@@ -65,24 +92,7 @@ void read_npy_into(Record& record, const std::string& name, const std::string& p
     throw bad("Fortran-order arrays are not supported (save with np.ascontiguousarray)");
   if (!std::regex_search(header, m, std::regex("'shape':\\s*\\(([^)]*)\\)")))
     throw bad("no 'shape' in the .npy header");
-  // Each dimension a non-negative integer, and the element count within what a record holds:
-  // (-1,) is not [1], and (2^32, 2^32, 4) does not wrap to a small array.
-  Shape shape;
-  const std::string dims = m[1];
-  const std::regex item("\\s*([^,]*?)\\s*(,|$)");
-  double elements = 1;
-  for (std::sregex_iterator it(dims.begin(), dims.end(), item), end; it != end; ++it) {
-    const std::string dim = (*it)[1];
-    if (dim.empty()) {
-      if ((*it)[2].length() == 0) break;  // the end (after a trailing comma)
-      throw bad("shape (" + dims + "): an empty dimension");
-    }
-    if (!std::regex_match(dim, std::regex("\\d{1,15}"))) throw bad("shape (" + dims + "): '" + dim + "' is not a size");
-    shape.push_back(std::stoll(dim));
-    elements *= static_cast<double>(shape.back());
-    if (shape.size() > static_cast<std::size_t>(kMaxDims)) throw bad("shape (" + dims + "): more than 8 dimensions");
-  }
-  if (elements > 1e12) throw bad("shape (" + dims + ") is larger than a record field can hold");
+  const Shape shape = npy_shape(m[1], path);
   DType dtype = DType::u8;
   bool found = false;
   for (DType d : {DType::u8, DType::i8, DType::u16, DType::i16, DType::u32, DType::i32, DType::u64,

@@ -20,6 +20,23 @@ cv::Point2f project(double x, double y, double z, int voxels, int size_px) {
   return cv::Point2f(static_cast<float>(u), static_cast<float>(v));
 }
 
+// One voxel's cube: its three visible faces, top (+z), front-left (+x) and front-right (+y),
+// shaded differently and outlined.
+void draw_cube(cv::Mat& image, const Eigen::Vector3i& at, const cv::Vec3d& bgr, int voxels, int size_px) {
+  const std::array<std::array<std::array<int, 3>, 4>, 3> faces = {{
+      {{{0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}}},
+      {{{1, 0, 0}, {1, 1, 0}, {1, 1, 1}, {1, 0, 1}}},
+      {{{0, 1, 0}, {1, 1, 0}, {1, 1, 1}, {0, 1, 1}}},
+  }};
+  const double shade[3] = {1.0, 0.8, 0.65};
+  for (int f = 0; f < 3; ++f) {
+    std::vector<cv::Point> corners;
+    for (const auto& c : faces[f]) corners.push_back(project(at.x() + c[0], at.y() + c[1], at.z() + c[2], voxels, size_px));
+    cv::fillConvexPoly(image, corners, cv::Scalar(bgr[0] * shade[f], bgr[1] * shade[f], bgr[2] * shade[f]), cv::LINE_AA);
+    cv::polylines(image, corners, true, cv::Scalar(60, 60, 60), 1, cv::LINE_AA);
+  }
+}
+
 }  // namespace
 
 void save_voxel_png(const std::string& path, const float* grid, int voxels, const VoxelImageOptions& options) {
@@ -54,7 +71,6 @@ void save_voxel_png(const std::string& path, const float* grid, int voxels, cons
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return depth(a) < depth(b); });
   for (int i : order) {
     const Eigen::Vector3i at = index_from_flat(i, voxels);
-    const int x = at.x(), y = at.y(), z = at.z();
     cv::Vec3d bgr;
     if (options.values.empty()) {
       const float* c = grid + i * kChannels;
@@ -64,19 +80,7 @@ void save_voxel_png(const std::string& path, const float* grid, int voxels, cons
       const cv::Vec3b m = colour_map.at<cv::Vec3b>(0, std::clamp(static_cast<int>(t * 255), 0, 255));
       bgr = cv::Vec3d(m[0], m[1], m[2]);
     }
-    // Three visible faces: top (+z), front-left (+x), front-right (+y), shaded differently.
-    const std::array<std::array<std::array<int, 3>, 4>, 3> faces = {{
-        {{{0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}}},
-        {{{1, 0, 0}, {1, 1, 0}, {1, 1, 1}, {1, 0, 1}}},
-        {{{0, 1, 0}, {1, 1, 0}, {1, 1, 1}, {0, 1, 1}}},
-    }};
-    const double shade[3] = {1.0, 0.8, 0.65};
-    for (int f = 0; f < 3; ++f) {
-      std::vector<cv::Point> corners;
-      for (const auto& c : faces[f]) corners.push_back(project(x + c[0], y + c[1], z + c[2], voxels, options.size_px));
-      cv::fillConvexPoly(image, corners, cv::Scalar(bgr[0] * shade[f], bgr[1] * shade[f], bgr[2] * shade[f]), cv::LINE_AA);
-      cv::polylines(image, corners, true, cv::Scalar(60, 60, 60), 1, cv::LINE_AA);
-    }
+    draw_cube(image, at, bgr, voxels, options.size_px);
   }
   // The marked voxel's outline last, all twelve edges, so cubes in front do not hide it.
   if (options.marked_x >= 0 && options.marked_y >= 0 && options.marked_z >= 0) {

@@ -1,10 +1,12 @@
 #include "voxels/voxels_record.hpp"
 
+#include <cstdio>
 #include <memory>
 
 #include "voxels/grid_fields.hpp"
 #include "voxels/observation_cloud.hpp"
 #include "voxels/occupancy_channels.hpp"
+#include "voxels/voxel_image.hpp"
 
 namespace qte::voxels {
 
@@ -42,6 +44,25 @@ VoxelsOfObservation voxels_of(const stream::Record& obs, const VoxelsRecordOptio
   out.record.set<float>("depth1.grid", {k, v, v, v, channels}, grids);
   out.record.set<double>("depth1.bounds", {k, 4}, bounds);
   return out;
+}
+
+void VoxelizeStage::handle(const stream::Record& record, const stream::Emit& emit) {
+  emit(record);
+  if (record.type() != "obs") return;
+  const VoxelsOfObservation out = voxels_of(prepare_ ? prepare_(record) : record, options_);
+  if (!png_dir_.empty()) save_pictures(record.position.record_index, out.grids);
+  emit(out.record);
+}
+
+void VoxelizeStage::save_pictures(uint64_t record_index, const std::vector<float>& grids) const {
+  const int v = options_.scene.voxels;
+  const std::size_t grid_floats = static_cast<std::size_t>(v) * v * v * kChannels;
+  char index[24];
+  std::snprintf(index, sizeof index, "%06llu", static_cast<unsigned long long>(record_index));
+  save_voxel_png(png_dir_ + "/" + index + ".depth0.png", grids.data(), v);
+  for (std::size_t c = 0; c < options_.crops.size(); ++c)
+    save_voxel_png(png_dir_ + "/" + index + ".depth1." + std::to_string(c) + ".png",
+                   grids.data() + (1 + c) * grid_floats, v);
 }
 
 }  // namespace qte::voxels

@@ -5,9 +5,12 @@
 // OctoMap) when asked for.
 #pragma once
 
+#include <functional>
+#include <string>
 #include <vector>
 
 #include "stream/record.hpp"
+#include "stream/stage.hpp"
 #include "voxels/voxel_grid.hpp"
 
 namespace qte::voxels {
@@ -25,5 +28,22 @@ struct VoxelsOfObservation {
 };
 
 VoxelsOfObservation voxels_of(const stream::Record& obs, const VoxelsRecordOptions& options);
+
+// The voxelize stage: every record passes through; after each 'obs' its 'voxels' record, made
+// from what `prepare` makes of the observation (point-cloud filters) when one is given. With
+// `png_dir`, pictures of the grids: <record index>.depth0.png, <record index>.depth1.<crop>.png.
+class VoxelizeStage : public stream::Stage {
+ public:
+  VoxelizeStage(VoxelsRecordOptions options, std::string png_dir = "",
+                std::function<stream::Record(const stream::Record&)> prepare = nullptr)
+      : options_(std::move(options)), png_dir_(std::move(png_dir)), prepare_(std::move(prepare)) {}
+  void handle(const stream::Record& record, const stream::Emit& emit) override;
+
+ private:
+  void save_pictures(uint64_t record_index, const std::vector<float>& grids) const;
+  VoxelsRecordOptions options_;
+  std::string png_dir_;
+  std::function<stream::Record(const stream::Record&)> prepare_;
+};
 
 }  // namespace qte::voxels

@@ -58,12 +58,13 @@ int main(int argc, char** argv) {
   replay::ReplayBuffer replay;
   keyframes::TransitionOptions transition_options;
   transition_options.hierarchy = config.hierarchy;
-  keyframes::EpisodeConverter converter(transition_options, [&](const stream::Record& r) { replay.add(r); });
+  keyframes::EpisodeConverter converter(transition_options);
+  const stream::Emit to_replay = [&](const stream::Record& r) { replay.add(r); };
   demos::DemoOptions demo_options;
   demo_options.episodes = {"pick_and_lift", 0, 10, 1};
-  demos::record_demos(robot::RobotModel::xarm7(), demo_options, [&](const stream::Record& r) { converter.handle(r); },
+  demos::record_demos(robot::RobotModel::xarm7(), demo_options, [&](const stream::Record& r) { converter.handle(r, to_replay); },
                       [](const std::string&) {});
-  converter.finish();
+  converter.finish(to_replay);
   std::printf("replay: %zu transitions, %zu frames (10 pick_and_lift demos)\n", replay.size(), replay.frame_count());
 
   if (compare > 0) {

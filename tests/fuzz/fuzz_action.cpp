@@ -8,13 +8,14 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   qte::keyframes::TransitionOptions options;
   options.demo = false;
-  qte::keyframes::AgentEpisodeConverter converter(options, [](const qte::stream::Record&) {});
+  qte::keyframes::AgentEpisodeConverter converter(options);
+  const qte::stream::Emit drop = [](const qte::stream::Record&) {};
   qte::fuzz::for_each_record(data, size, [&](const qte::stream::Record& record) {
     if (record.type() == "action") (void)qte::planning::goal_from(record);
-    converter.handle(record);
+    converter.handle(record, drop);
   });
   try {
-    converter.finish();
+    converter.finish(drop);
   } catch (const qte::Error&) {
   }
   return 0;

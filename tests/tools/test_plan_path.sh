@@ -2,8 +2,10 @@
 # plan-path between the simulator's observations and its trajectories.
 source "$(dirname "$0")/common.sh"
 
-stream-pack reset task=pick_and_lift seed:i64=2 > "$tmp/reset.rec"
-sim-step < "$tmp/reset.rec" > "$tmp/obs.rec" || fail "sim-step"
+src=${QTE_SOURCE:?set QTE_SOURCE to the repository}
+# A pick_and_lift scene's first observation at 64x64, and its reset (tests/data/make_data.sh).
+cp "$src/tests/data/pick_and_lift_reset.rec" "$tmp/reset.rec"
+cp "$src/tests/data/pick_and_lift_obs.rec" "$tmp/obs.rec"
 # 40 cm above the table, gripper pointing down (180 deg about x: qx = 1).
 stream-pack action pose:f64=0.1,0.0,1.15,1,0,0,0 gripper_open:u8=1 > "$tmp/action.rec"
 cat "$tmp/obs.rec" "$tmp/action.rec" | plan-path --seed 3 --octomap "$tmp/scene.bt" > "$tmp/planned.rec" 2> "$tmp/err" \
@@ -17,7 +19,8 @@ head -c 40 "$tmp/scene.bt" | grep -q "Octomap OcTree binary file" || fail "--oct
 cat "$tmp/obs.rec" "$tmp/action.rec" | plan-path --seed 3 | cmp -s - "$tmp/planned.rec" || fail "same input and seed, different bytes"
 
 # The trajectory executes in the simulator: it starts where the arm is, stays within limits.
-{ cat "$tmp/reset.rec"; stream-cat --type trajectory "$tmp/planned.rec"; } | sim-step > "$tmp/after.rec" || fail "sim-step on the plan"
+{ cat "$tmp/reset.rec"; stream-cat --type trajectory "$tmp/planned.rec"; } | sim-step --image-size 64x64 > "$tmp/after.rec" \
+  || fail "sim-step on the plan"
 stream-dump --json --type obs "$tmp/after.rec" | tail -n 1 > "$tmp/last.json"
 grep -q '"name":"failure"' "$tmp/last.json" && fail "the planned trajectory failed in the simulator: $(grep -o '"name":"failure"[^}]*' "$tmp/last.json")"
 grep -q '"name":"step","dtype":"int32","shape":\[\],"values":\[1\]' "$tmp/last.json" || fail "no observation after the move"

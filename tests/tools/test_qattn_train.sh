@@ -3,8 +3,8 @@
 # byte for byte after an interruption or a kill, following a growing replay, bad input.
 source "$(dirname "$0")/common.sh"
 
-demo-record --task lift_numbered_block --episodes 2 --seed 3 --image-size 48x48 --output "$tmp/demos.rec" 2>/dev/null \
-  || fail "demo-record"
+src=${QTE_SOURCE:?set QTE_SOURCE to the repository}
+cp "$src/tests/data/lift_numbered_block_demo.rec" "$tmp/demos.rec"  # one demonstration (tests/data/make_data.sh)
 keyframe --seed 1 --output "$tmp/tr.rec" "$tmp/demos.rec" 2>/dev/null || fail "keyframe"
 # Options as arrays: a program started in the background must be the process $! names (a
 # shell function would run it under a subshell, and kill -9 of that would leave it running).

@@ -10,8 +10,7 @@ src=${QTE_SOURCE:?set QTE_SOURCE to the repository}
 export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-PASSIVE}
 
 # Fresh networks for the transitions of one demonstration.
-demo-record --task reach_target --episodes 1 --seed 1 --image-size 32x32 --output "$tmp/demos.rec" 2>/dev/null \
-  || fail "demo-record"
+cp "$src/tests/data/reach_target_demo.rec" "$tmp/demos.rec"  # one demonstration (tests/data/make_data.sh)
 keyframe "$tmp/demos.rec" > "$tmp/transitions.rec" 2>/dev/null || fail "keyframe"
 qattn-train --steps 0 --seed 1 --checkpoint-dir "$tmp/ckpt" "$tmp/transitions.rec" 2>/dev/null \
   || fail "qattn-train --steps 0: exit $?"

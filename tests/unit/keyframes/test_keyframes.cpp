@@ -167,9 +167,10 @@ std::vector<stream::Record> one_demonstration(const std::string& task, int pixel
 TEST(Transitions, ChainsRewardsAndReferencesToStoredFrames) {
   std::vector<stream::Record> out;
   TransitionOptions transition_options;
-  EpisodeConverter converter(transition_options, [&](const stream::Record& r) { out.push_back(r); });
-  for (const auto& r : one_demonstration("pick_and_lift", 32)) converter.handle(r);
-  converter.finish();
+  EpisodeConverter converter(transition_options);
+  const stream::Emit keep = [&](const stream::Record& r) { out.push_back(r); };
+  for (const auto& r : one_demonstration("pick_and_lift", 32)) converter.handle(r, keep);
+  converter.finish(keep);
   ASSERT_EQ(converter.counts().converted, 1);
   std::set<int> frames;
   int from_start = 0, rewarded = 0;
@@ -233,12 +234,13 @@ TEST(Transitions, BadEpisodesAreSkippedAndCounted) {
   failed.back().set_scalar<uint8_t>("success", 0);
   // Each episode ends with an 'episode' record without a success field: use the last obs's.
   std::vector<stream::Record> out;
-  EpisodeConverter converter(TransitionOptions{}, [&](const stream::Record& r) { out.push_back(r); });
+  EpisodeConverter converter(TransitionOptions{});
+  const stream::Emit keep = [&](const stream::Record& r) { out.push_back(r); };
   for (const auto* episode : {&good, &empty, &single, &out_of_order, &outside, &failed}) {
-    for (const auto& r : *episode) converter.handle(r);
+    for (const auto& r : *episode) converter.handle(r, keep);
     stream::Record end("episode");
     end.set_scalar<uint8_t>("success", episode->empty() ? 0 : episode->back().scalar<uint8_t>("success"));
-    converter.handle(end);
+    converter.handle(end, keep);
   }
   const ConversionCounts& c = converter.counts();
   EXPECT_EQ(c.episodes, 6);
@@ -265,10 +267,11 @@ TEST(Transitions, AGripperPoseWithoutARotationIsRefused) {
         r.set<double>("gripper_pose", {7}, std::vector<double>{p[0], p[1], p[2], quaternion[0], quaternion[1],
                                                                quaternion[2], quaternion[3]});
       }
-    EpisodeConverter converter(TransitionOptions{}, [](const stream::Record&) {});
+    EpisodeConverter converter(TransitionOptions{});
+    const stream::Emit drop = [](const stream::Record&) {};
     try {
-      for (const auto& r : damaged) converter.handle(r);
-      converter.finish();
+      for (const auto& r : damaged) converter.handle(r, drop);
+      converter.finish(drop);
       ADD_FAILURE() << "converted an episode without rotations";
     } catch (const StreamError& e) {
       EXPECT_NE(std::string(e.what()).find("field 'gripper_pose'"), std::string::npos) << e.what();

@@ -271,3 +271,52 @@ TEST(SceneSets, DemoExplorationAndEvaluationSeedsAreDisjointForSeedsZeroToNine) 
   EXPECT_EQ(scene_set_from_name("eval"), SceneSet::eval);
   EXPECT_THROW(scene_set_from_name("test"), qte::UsageError);
 }
+
+// The sim-step stage with a plan: the first observation goes out before any input is read,
+// the next episode starts right after a terminal observation, and after the planned episodes
+// the stage reads no more.
+TEST(SimStep, APlanStartsEpisodesByItselfAndEndsAfterThem) {
+  Simulator simulator(xarm(), small_options());
+  SimStep stage(simulator, EpisodePlan{"reach_target", 0, 2, 7});
+  std::vector<stream::Record> out;
+  int reads = 0;
+  stream::run_stage(
+      stage,
+      [&]() -> std::optional<stream::Record> {
+        EXPECT_FALSE(out.empty()) << "input read before the first observation";
+        ++reads;
+        // Not from the current joints: the action fails and the episode ends.
+        return test_support::straight_trajectory(xarm(), robot::JointVector::Zero(), robot::JointVector::Ones(), true);
+      },
+      [&](const stream::Record& obs) { out.push_back(obs); });
+  EXPECT_EQ(reads, 2);  // one failing action per episode, then done
+  ASSERT_EQ(out.size(), 4u);
+  for (int episode = 0; episode < 2; ++episode) {
+    EXPECT_EQ(out[2 * episode].scalar<int32_t>("step"), 0);
+    EXPECT_EQ(out[2 * episode + 1].scalar<uint8_t>("terminal"), 1);
+    EXPECT_TRUE(out[2 * episode + 1].has("failure"));
+  }
+  EXPECT_EQ(out[0].scalar<int64_t>("episode_seed"), plan_reset(EpisodePlan{"reach_target", 0, 2, 7}, 0).scalar<int64_t>("seed"));
+  EXPECT_EQ(out[2].scalar<int64_t>("episode_seed"), plan_reset(EpisodePlan{"reach_target", 0, 2, 7}, 1).scalar<int64_t>("seed"));
+}
+
+// Without a plan the stage is the simulator: nothing before the input, and it runs until the
+// input ends.
+TEST(SimStep, WithoutAPlanTheInputDrivesEverything) {
+  Simulator simulator(xarm(), small_options());
+  SimStep stage(simulator, std::nullopt);
+  std::vector<stream::Record> in = {reset_record("reach_target", 0, 3), stream::Record("action"),
+                                    reset_record("reach_target", 0, 4)};
+  std::size_t next = 0;
+  std::vector<stream::Record> out;
+  stream::run_stage(
+      stage,
+      [&]() -> std::optional<stream::Record> {
+        if (next == in.size()) return std::nullopt;
+        return in[next++];
+      },
+      [&](const stream::Record& obs) { out.push_back(obs); });
+  EXPECT_EQ(next, in.size());
+  ASSERT_EQ(out.size(), 2u);  // one observation per reset; other records produce nothing
+  EXPECT_FALSE(stage.done());
+}

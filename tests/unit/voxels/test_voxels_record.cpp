@@ -1,6 +1,10 @@
 // The 'voxels' record of an observation against the voxelizer called directly: the scene grid,
 // the crops (one pass over the points) with their bounds, and the OctoMap channels' layout.
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
 
 #include "sim_step/simulator.hpp"
 #include "voxels/grid_fields.hpp"
@@ -69,4 +73,44 @@ TEST(VoxelsRecord, OccupancyChannelsFollowTheTenAndNoCropsMeansNoDepth1) {
   const auto with = out.record.array<float>("depth0.grid"), without = plain.record.array<float>("depth0.grid");
   for (int cell = 0; cell < 8 * 8 * 8; ++cell)
     for (int k = 0; k < voxels::kChannels; ++k) ASSERT_EQ(with[cell * c + k], without[cell * voxels::kChannels + k]);
+}
+
+// The voxelize stage: every record passes through in order, an 'obs' is followed by its
+// 'voxels' record (that of what `prepare` made of it), and pictures are named by record index.
+TEST(VoxelizeStage, PassesRecordsThroughAndFollowsEachObservationWithItsVoxels) {
+  stream::Record obs = first_observation();
+  obs.position.record_index = 4;
+  voxels::VoxelsRecordOptions options;
+  options.crops = {voxels::GridBounds::around({0.2, 0.0, 0.8}, 0.15, 16)};
+  const std::string pictures = ::testing::TempDir();
+  // Every point dropped (NaN: no return): the stage must voxelize this, not the record it passes on.
+  const auto without_points = [](const stream::Record& r) {
+    stream::Record emptied = r;
+    const auto points = r.array<float>("front.points");
+    emptied.set<float>("front.points", points.shape, std::vector<float>(points.size(), NAN));
+    return emptied;
+  };
+  int prepared = 0;
+  voxels::VoxelizeStage stage(options, pictures, [&](const stream::Record& r) {
+    ++prepared;
+    return without_points(r);
+  });
+  std::vector<stream::Record> out;
+  const stream::Emit keep = [&](const stream::Record& r) { out.push_back(r); };
+  stage.handle(stream::Record("reset"), keep);
+  stage.handle(obs, keep);
+  ASSERT_EQ(out.size(), 3u);
+  EXPECT_EQ(out[0].type(), "reset");
+  EXPECT_EQ(out[1].type(), "obs");
+  EXPECT_EQ(out[1].field("front.points").shape(), obs.field("front.points").shape());  // passed on unchanged
+  EXPECT_EQ(out[2].type(), "voxels");
+  EXPECT_EQ(prepared, 1);
+  EXPECT_EQ(field_floats(out[2], "depth0.grid"),
+            field_floats(voxels::voxels_of(without_points(obs), options).record, "depth0.grid"));
+  EXPECT_NE(field_floats(out[2], "depth0.grid"), field_floats(voxels::voxels_of(obs, options).record, "depth0.grid"));
+  for (const char* name : {"000004.depth0.png", "000004.depth1.0.png"}) {
+    const std::string path = pictures + "/" + name;
+    EXPECT_EQ(::access(path.c_str(), R_OK), 0) << path;
+    std::remove(path.c_str());
+  }
 }
