@@ -28,8 +28,8 @@ static cli::Usage usage() {
       {"retries", "N", "new seeds to try for an episode whose expert failed", "0"},
       {"no-points", "", "leave point clouds out of the recorded observations (the planner still uses them)", ""},
       {"time-budget", "S", "planner time budget per move, seconds", "2"},
-      {"output", "FILE", "where to write; '-' is standard output", "-"},
   };
+  u.options.push_back(cli::output_file());
   u.add_options(sim_step::episode_options(10, sim_step::SceneSet::demo));
   u.add_options(sim_step::camera_options());
   u.uses_randomness = true;

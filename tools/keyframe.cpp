@@ -46,10 +46,10 @@ static cli::Usage usage() {
       {"no-crop-augmentation", "", "use the unshifted centres for the deeper grids", ""},
       {"keep-failed", "", "also convert unsuccessful episodes (reward 0 throughout)", ""},
       {"not-demo", "", "mark the transitions as the agent's own, not demonstrations", ""},
-      {"output", "FILE", "where to write; '-' is standard output", "-"},
       {"append", "", "append to --output (a growing replay file)", ""},
       {"agent", "", "convert the agent's episodes (obs and action records) instead of demonstrations", ""},
   };
+  u.options.push_back(cli::output_file());
   u.add_options(voxels::hierarchy_options());
   u.uses_randomness = true;
   u.examples = {

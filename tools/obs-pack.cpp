@@ -52,8 +52,8 @@ static cli::Usage usage() {
       {"task", "NAME", "the records' task name", "real"},
       {"episode-length", "N", "next-best poses per episode (the networks' time input scales by it)", "10"},
       {"no-points", "", "do not store <camera>.points (readers rebuild them from depth; plan-path needs them)", ""},
-      {"output", "FILE", "where to write; '-' is standard output", "-"},
   };
+  u.options.push_back(cli::output_file());
   u.examples = {
       {"obs-pack --rgb rec/color_%06d.png --depth rec/depth_%06d.png --intrinsics 615.2,615.0,320.5,240.1 "
        "--camera-pose 1.0,0,1.4,-0.65,0.65,-0.27,0.27 --joints rec/joints.csv > real.rec",

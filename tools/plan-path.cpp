@@ -40,8 +40,8 @@ static cli::Usage usage() {
       {"clearance", "M", "extra distance in metres kept from occupied voxels", "0"},
       {"resolution", "M", "OctoMap voxel size in metres", "0.01"},
       {"octomap", "FILE.bt", "write the scene map of the last planned action (opens in octovis)", ""},
-      {"output", "FILE", "where to write; '-' is standard output", "-"},
   };
+  u.options.push_back(cli::output_file());
   u.add_options(point_clouds::cloud_filter_options());
   u.uses_randomness = true;
   u.examples = {

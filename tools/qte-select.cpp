@@ -77,8 +77,8 @@ static cli::Usage usage() {
        "their last bit (measured: the same voxels in 19 of 19 actions, 3 values 1e-7 apart)",
        "2"},
       {"png", "DIR", "save the Q-values of every depth's grid as DIR/<n>.depth<d>.png", ""},
-      {"output", "FILE", "where to write; '-' is standard output", "-"},
   };
+  u.options.push_back(cli::output_file());
   u.add_options(voxels::checkpoint_hierarchy_options());
   u.add_options(qattention::branching_options());
   u.add_options(point_clouds::cloud_filter_options());

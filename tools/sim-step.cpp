@@ -44,8 +44,8 @@ static cli::Usage usage() {
                          "(full demonstrations)", ""},
       {"no-points", "", "leave the world-frame point clouds out of observations", ""},
       {"threads", "N", "rendering threads", "2"},
-      {"output", "FILE", "where to write; '-' is standard output", "-"},
   };
+  u.options.push_back(cli::output_file());
   u.add_options(sim_step::episode_options(1, sim_step::SceneSet::any));
   u.add_options(sim_step::camera_options());
   u.uses_randomness = true;

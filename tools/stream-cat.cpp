@@ -22,7 +22,6 @@ static cli::Usage usage() {
   };
   u.arguments = {cli::input_files()};
   u.options = {
-      {"output", "FILE", "where to write; '-' is standard output", "-"},
       {"append", "", "append to --output instead of replacing it", ""},
       {"type", "T", "keep only records of type T", "", true},
       {"exclude", "T", "drop records of type T", "", true},
@@ -31,6 +30,7 @@ static cli::Usage usage() {
       {"max-record-bytes", "N", "treat a record payload or decompressed field larger than N bytes as damage",
        std::to_string(uint64_t(4) << 30)},
   };
+  u.options.push_back(cli::output_file());
   u.examples = {
       {"stream-cat ep1.rec ep2.rec --output all.rec", "join two files into one (atomically)"},
       {"stream-cat --type transition --append --output replay.rec < episode.rec",

@@ -23,10 +23,10 @@ static cli::Usage usage() {
   u.arguments = {{"TYPE", "record type, 1-16 characters of [a-z0-9_] (e.g. reset)", false, false},
                  {"FIELD", "field specifications, see above", true, true}};
   u.options = {
-      {"output", "FILE", "where to write; '-' is standard output", "-"},
       {"append", "", "append to --output instead of replacing it", ""},
       {"compress", "", "zstd-compress arrays of 256 bytes or more", ""},
   };
+  u.options.push_back(cli::output_file());
   u.examples = {
       {"stream-pack reset task=reach_target variation:i32=0 seed:i64=7 > reset.rec",
        "a reset record for sim-step"},

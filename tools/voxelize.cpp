@@ -40,8 +40,8 @@ static cli::Usage usage() {
       {"offset", "M", "half edge of the deeper grids, metres", "0.15"},
       {"octomap-channels", "", "add the free and unknown channels (12 in all)", ""},
       {"png", "DIR", "save a picture of every grid as DIR/<record>.depth<d>[.<k>].png", ""},
-      {"output", "FILE", "where to write; '-' is standard output", "-"},
   };
+  u.options.push_back(cli::output_file());
   u.add_options(voxels::scene_options());
   u.add_options(point_clouds::cloud_filter_options());
   u.examples = {

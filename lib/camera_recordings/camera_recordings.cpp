@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "common/error.hpp"
+#include "robot/pose_values.hpp"
 
 namespace qte::camera_recordings {
 
@@ -78,11 +79,9 @@ void add_camera_cloud(stream::Record& obs, const CameraSetup& camera, const voxe
 void add_robot_state(stream::Record& obs, const RobotState& state, const robot::RobotModel& robot,
                      const Eigen::Isometry3d& world_from_base) {
   const Eigen::Isometry3d tcp = world_from_base * robot.tcp_pose(state.joints);
-  const Eigen::Quaterniond q(tcp.linear());
   obs.set<double>("joint_positions", {robot::kArmJoints}, state.joints.data());
   obs.set<double>("joint_velocities", {robot::kArmJoints}, std::vector<double>(robot::kArmJoints, 0.0));
-  obs.set<double>("gripper_pose", {7}, std::vector<double>{tcp.translation().x(), tcp.translation().y(),
-                                                            tcp.translation().z(), q.x(), q.y(), q.z(), q.w()});
+  obs.set<double>("gripper_pose", {robot::kPoseValues}, robot::pose_values(tcp));
   obs.set_scalar<uint8_t>("gripper_open", state.gripper_opening_m > robot.max_finger_opening_m() / 2);
   obs.set_scalar<double>("gripper_opening_m", state.gripper_opening_m);
 }

@@ -117,6 +117,8 @@ ArgumentSpec input_files(const std::string& what) {
   return {"FILE", what + "; '-' or absent is standard input", true, true};
 }
 
+OptionSpec output_file() { return {"output", "FILE", "where to write; '-' is standard output", "-"}; }
+
 bool Arguments::has(const std::string& name) const { return given_.count(name) > 0; }
 
 bool Arguments::flag(const std::string& name) const { return has(name); }

@@ -32,6 +32,8 @@ struct ArgumentSpec {
 ArgumentSpec input_file(const std::string& what = "input records");
 // Streams read one after another; none means standard input (Arguments::inputs()).
 ArgumentSpec input_files(const std::string& what = "record streams to read in order");
+// The record-stream output of a tool: --output FILE, standard output by default.
+OptionSpec output_file();
 
 struct Example {
   std::string command;

@@ -5,6 +5,8 @@
 
 #include "common/random.hpp"
 #include "keyframes/keyframes.hpp"
+#include "robot/pose_values.hpp"
+#include "robot/rotation_bins.hpp"
 #include "tasks/episode.hpp"
 #include "voxels/grid_fields.hpp"
 #include "voxels/observation_cloud.hpp"
@@ -21,15 +23,12 @@ uint64_t fnv1a(const void* data, std::size_t n, uint64_t h = 1469598103934665603
 
 Eigen::Isometry3d gripper_pose(const stream::Record& obs) {
   const auto p = obs.array<double>("gripper_pose");
-  if (p.size() != 7) obs.fail("gripper_pose", "float64 [7]");
+  if (p.size() != robot::kPoseValues) obs.fail("gripper_pose", "float64 [7]");
   const double norm = std::sqrt(p[3] * p[3] + p[4] * p[4] + p[5] * p[5] + p[6] * p[6]);
-  for (int i = 0; i < 7; ++i)
+  for (int i = 0; i < robot::kPoseValues; ++i)
     if (!std::isfinite(p[i])) obs.fail("gripper_pose", "finite position and quaternion");
   if (!(norm > 0.5 && norm < 1.5)) obs.fail("gripper_pose", "a unit quaternion (x, y, z, w), got norm " + std::to_string(norm));
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.translation() << p[0], p[1], p[2];
-  pose.linear() = Eigen::Quaterniond(p[6], p[3], p[4], p[5]).normalized().toRotationMatrix();
-  return pose;
+  return robot::pose_from_values(p.data);
 }
 
 // The episode's key: what identifies it, hashed (frames refer to it across appended files).
@@ -112,8 +111,8 @@ void AgentEpisodeConverter::convert(const stream::Emit& emit) {
       r.set_scalar<uint8_t>("ignore_collisions",
                             action.has("ignore_collisions") ? action.scalar<uint8_t>("ignore_collisions") : 0);
       const auto pose = action.array<double>("pose");
-      if (pose.size() != 7) action.fail("pose", "float64 [7]");
-      r.set<double>("target_pose", {7}, pose.data);
+      if (pose.size() != robot::kPoseValues) action.fail("pose", "float64 [7]");
+      r.set<double>("target_pose", {robot::kPoseValues}, pose.data);
       r.set_scalar<float>("reward", next.scalar<float>("reward"));
       r.set_scalar<uint8_t>("terminal", next.scalar<uint8_t>("terminal"));
       r.set_scalar<uint8_t>("demo", 0);
@@ -276,14 +275,12 @@ stream::Record EpisodeConverter::transition(const std::vector<stream::Record>& e
     t.set<double>(prefix + ".bounds", {4}, voxels::bounds_values(b));
     centre = b.centre_of(indices[d]);
   }
-  const Eigen::Vector3i bins = rotation_bins(pose.linear());
+  const Eigen::Vector3i bins = robot::rotation_bins(pose.linear());
   t.set<int32_t>("rotation_bins", {3}, bins.data());
   t.set_scalar<uint8_t>("gripper_open", target.scalar<uint8_t>("gripper_open"));
   t.set_scalar<uint8_t>("ignore_collisions",
                         target.has("ignore_collisions") ? target.scalar<uint8_t>("ignore_collisions") : 0);
-  const Eigen::Quaterniond q(pose.linear());
-  t.set<double>("target_pose", {7}, std::vector<double>{pose.translation().x(), pose.translation().y(),
-                                                        pose.translation().z(), q.x(), q.y(), q.z(), q.w()});
+  t.set<double>("target_pose", {robot::kPoseValues}, robot::pose_values(pose));
   t.set_scalar<float>("reward", last && success ? tasks::kSuccessReward : 0.0f);
   t.set_scalar<uint8_t>("terminal", last);
   t.set_scalar<uint8_t>("demo", options_.demo);

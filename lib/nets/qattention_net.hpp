@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "keyframes/keyframes.hpp"
+#include "robot/rotation_bins.hpp"
 
 namespace qte::nets {
 
@@ -26,7 +26,7 @@ int default_base_channels(Architecture architecture);          // arm 64, light 
 
 // Rotation Q values: 3 Euler axes x 72 bins of 5 degrees; gripper: open / close.
 constexpr int kRotationAxes = 3;
-using keyframes::kRotationBins;  // the action encoding's bins (keyframes/keyframes.hpp)
+using robot::kRotationBins;  // the action encoding's bins (robot/rotation_bins.hpp)
 constexpr int kGripperActions = 2;
 
 struct NetConfig {

@@ -11,6 +11,7 @@
 
 #include "common/random.hpp"
 #include "planning/time_parametrization.hpp"
+#include "robot/pose_values.hpp"
 
 namespace qte::planning {
 namespace ob = ompl::base;
@@ -73,13 +74,13 @@ StartState start_state_from(const stream::Record& obs) {
 
 Goal goal_from(const stream::Record& action) {
   const auto pose = action.array<double>("pose");
-  if (pose.size() != 7) action.fail("pose", "float64 [7]: x, y, z, qx, qy, qz, qw");
+  if (pose.size() != robot::kPoseValues) action.fail("pose", "float64 [7]: x, y, z, qx, qy, qz, qw");
   Goal goal;
-  const Eigen::Quaterniond rotation(pose[6], pose[3], pose[4], pose[5]);
+  const Eigen::Quaterniond rotation = robot::quaternion_of(pose.data);
   goal.tcp_pose.translation() << pose[0], pose[1], pose[2];
   goal.pose_valid = goal.tcp_pose.translation().allFinite() && rotation.coeffs().allFinite() &&
                     std::abs(rotation.norm() - 1.0) <= 1e-3;
-  if (goal.pose_valid) goal.tcp_pose.linear() = rotation.normalized().toRotationMatrix();
+  if (goal.pose_valid) goal.tcp_pose = robot::pose_from_values(pose.data);
   goal.gripper_open = action.has("gripper_open") ? action.scalar<uint8_t>("gripper_open") != 0 : true;
   goal.ignore_collisions = action.has("ignore_collisions") && action.scalar<uint8_t>("ignore_collisions") != 0;
   return goal;
@@ -267,9 +268,7 @@ PlanResult MotionPlanner::rrt_connect(const StartState& start, const robot::Join
 
 stream::Record action_record(const Goal& goal) {
   stream::Record action("action");
-  const Eigen::Quaterniond q(goal.tcp_pose.linear());
-  const Eigen::Vector3d p = goal.tcp_pose.translation();
-  action.set<double>("pose", {7}, std::vector<double>{p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w()});
+  action.set<double>("pose", {robot::kPoseValues}, robot::pose_values(goal.tcp_pose));
   action.set_scalar<uint8_t>("gripper_open", goal.gripper_open);
   action.set_scalar<uint8_t>("ignore_collisions", goal.ignore_collisions);
   return action;

@@ -4,7 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "keyframes/keyframes.hpp"
+#include "robot/pose_values.hpp"
+#include "robot/rotation_bins.hpp"
 #include "voxels/grid_fields.hpp"
 
 namespace qte::qattention {
@@ -14,9 +15,9 @@ stream::Record action_record(const Choice& choice, bool ignore_collisions, int k
   const Choice& c = choice;
   stream::Record a("action");
   const Eigen::Vector3d p = c.position();
-  Eigen::Quaterniond q(keyframes::rotation_from_bins(c.rotation_bins));
+  Eigen::Quaterniond q(robot::rotation_from_bins(c.rotation_bins));
   q.normalize();
-  a.set<double>("pose", {7}, std::vector<double>{p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w()});
+  a.set<double>("pose", {robot::kPoseValues}, robot::pose_values(p, q));
   a.set_scalar<uint8_t>("gripper_open", c.gripper_open ? 1 : 0);
   a.set_scalar<uint8_t>("ignore_collisions", ignore_collisions ? 1 : 0);
   for (std::size_t d = 0; d < c.indices.size(); ++d) {

@@ -7,6 +7,7 @@
 #include "common/error.hpp"
 #include "common/random.hpp"
 #include "robot/joint_path.hpp"
+#include "robot/pose_values.hpp"
 
 namespace qte::sim_step {
 namespace {
@@ -90,11 +91,7 @@ stream::Record Simulator::observe(const std::string& failure) {
   const robot::JointVector& q = world_->joint_positions();
   obs.set<double>("joint_positions", {7}, q.data());
   obs.set<double>("joint_velocities", {7}, velocity_.data());
-  const Eigen::Isometry3d tcp = world_->tcp_pose();
-  const Eigen::Quaterniond rotation(tcp.linear());
-  const std::vector<double> pose = {tcp.translation().x(), tcp.translation().y(), tcp.translation().z(),
-                                    rotation.x(), rotation.y(), rotation.z(), rotation.w()};
-  obs.set<double>("gripper_pose", {7}, pose);
+  obs.set<double>("gripper_pose", {robot::kPoseValues}, robot::pose_values(world_->tcp_pose()));
   obs.set_scalar<uint8_t>("gripper_open", world_->gripper_open());
   obs.set_scalar<double>("gripper_opening_m", world_->finger_opening_m());
   obs.set_scalar<int32_t>("step", step_);

@@ -1,4 +1,4 @@
-// Keyframe discovery case by case, on expert demonstrations, rotation bins, and the
+// Keyframe discovery case by case and on expert demonstrations, and the
 // transitions' crop augmentation.
 #include <gtest/gtest.h>
 
@@ -72,24 +72,6 @@ TEST(Keyframes, TooShortForAnything) {
   EXPECT_TRUE(discover_keyframes({}).empty());
   EXPECT_EQ(discover_keyframes(moving(1)), std::vector<int>{});
   EXPECT_EQ(discover_keyframes(moving(2)), std::vector<int>{1});
-}
-
-TEST(RotationBins, RoundTripWithinHalfABin) {
-  std::mt19937 rng(6);
-  std::uniform_real_distribution<double> angle(-M_PI, M_PI), pitch(-1.4, 1.4);
-  for (int i = 0; i < 2000; ++i) {
-    const Eigen::Vector3d a(angle(rng), pitch(rng), angle(rng));
-    const Eigen::Vector3i bins = rotation_bins(from_euler_xyz(a));
-    ASSERT_TRUE((bins.array() >= 0).all() && (bins.array() < kRotationBins).all());
-    const Eigen::Vector3d back = euler_xyz(rotation_from_bins(bins));
-    for (int k = 0; k < 3; ++k) {
-      const double difference = std::remainder(back[k] - a[k], 2 * M_PI) * 180 / M_PI;
-      EXPECT_LE(std::abs(difference), 2.5 + 1e-9) << "axis " << k;
-    }
-  }
-  // The top-down grasp: x = +-180 deg falls in bin 0 either way.
-  const Eigen::Matrix3d down = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
-  EXPECT_EQ(rotation_bins(down), Eigen::Vector3i(0, 36, 36));
 }
 
 TEST(CropAugmentation, TheTargetStaysInsideTheDeeperGrid) {
