@@ -1,16 +1,19 @@
 #!/usr/bin/env python3
 """Final success per method over seeds, from learn.sh's eval.csv files (one per run).
 
-    results_table.py [--markdown | --finals] RUN.csv...
+    results_table.py [--markdown | --finals | --k-ablation] RUN.csv...
 
 One row per label (method): the runs' final evaluations (the last eval_point of each run):
 the environment and learner steps they had taken (means), their success's mean and sample
 standard deviation, each run's successes with its Wilson 95% interval,
 and the mean training wall-clock (train_s) where the CSVs have it. --finals prints each run's
-final row instead (for a picture of final success per seed). Standard library only.
+final row instead (for a picture of final success per seed); --k-ablation the final rows of the
+runs that expand the same K when acting and in the target (labels qte-kK-tK), with K as a
+column (for a picture of success against K). Standard library only.
 """
 import argparse
 import csv
+import re
 import statistics
 import sys
 from collections import defaultdict
@@ -50,11 +53,18 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--markdown", action="store_true", help="a Markdown table instead of CSV")
     parser.add_argument("--finals", action="store_true", help="each run's final row, as CSV")
+    parser.add_argument("--k-ablation", action="store_true", help="final rows of the qte-kK-tK runs with K, as CSV")
     parser.add_argument("runs", nargs="+")
     args = parser.parse_args()
     runs = final_rows(args.runs)
-    if args.finals:
+    if args.finals or args.k_ablation:
         rows = [row for label in sorted(runs) for row in sorted(runs[label], key=lambda r: int(r["seed"]))]
+        if args.k_ablation:
+            same_k = [(re.fullmatch(r"qte-k(\d+)-t\1", row["label"]), row) for row in rows]
+            rows = [{"k": m.group(1), **row} for m, row in same_k if m]
+            rows.sort(key=lambda r: (int(r["k"]), int(r["seed"])))
+            if not rows:
+                return
         writer = csv.DictWriter(sys.stdout, fieldnames=list(rows[0].keys()), lineterminator="\n")
         writer.writeheader()
         writer.writerows(rows)
