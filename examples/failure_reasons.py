@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Where the agent went, episode by episode: the evidence for or against coarse ambiguity.
 
-    failure_reasons.py EXPERTS.rec AGENT.rec [--label L]
+    failure_reasons.py EXPERTS.rec AGENT.rec [--label L] [--seed S] [--episodes]
 
 EXPERTS.rec: the expert's demonstrations of the same scenes (demo-record --scenes eval with the
 evaluation's seed); AGENT.rec: the agent's greedy episodes of them (sim-step, qte-select,
@@ -15,7 +15,7 @@ episode is then one of
     target             not solved although it went for the target (a wrong height, rotation
                        or gripper command, or a failed action)
     elsewhere          nearer no object than 4 cm
-and the counts are printed as CSV: label, episodes, the four kinds, and failed_actions (the
+and the counts are printed as CSV: label, seed, episodes, the four kinds, and failed_actions (the
 episodes that ended on a failed action: the planner's or the simulator's reason, any kind).
 --episodes prints one line per episode on stderr: kind, distance to the nearest object, the
 failure. Run with Debian's python3."""
@@ -84,11 +84,11 @@ KINDS = ["success", "distractor", "target", "elsewhere"]
 def classify(expert, agent):
     """(kind, distance from where the agent went to the nearest object, failure reason)."""
     found = objects(expert[0])
-    target, _ = nearest(found, went_for([(r.fields["gripper_pose"], int(scalar(r, "gripper_open"))) for r in expert]))
     last = agent["obs"][-1]
     failure = scalar(last, "failure", "")
-    if not agent["actions"]:
-        return "elsewhere", float("inf"), failure
+    if not found or not agent["actions"]:  # nothing on the table to go for (reach_target's floating target)
+        return ("success" if int(scalar(last, "success", 0)) else "elsewhere"), float("inf"), failure
+    target, _ = nearest(found, went_for([(r.fields["gripper_pose"], int(scalar(r, "gripper_open"))) for r in expert]))
     chosen, distance = nearest(found, went_for([(a.fields["pose"], int(scalar(a, "gripper_open", 1)))
                                                 for a in agent["actions"]]))
     if int(scalar(last, "success", 0)):
@@ -103,6 +103,7 @@ def main():
     parser.add_argument("experts")
     parser.add_argument("agent")
     parser.add_argument("--label", default="")
+    parser.add_argument("--seed", default="", help="the run's seed, for the seed column")
     parser.add_argument("--episodes", action="store_true", help="one line per episode on stderr")
     args = parser.parse_args()
     experts, agent = expert_episodes(args.experts), agent_episodes(args.agent)
@@ -119,8 +120,8 @@ def main():
     kinds = Counter(kind for kind, _, _ in results)
     failed = sum(1 for _, _, failure in results if failure)
     out = csv.writer(sys.stdout, lineterminator="\n")
-    out.writerow(["label", "episodes"] + KINDS + ["failed_actions"])
-    out.writerow([args.label, len(agent)] + [kinds[k] for k in KINDS] + [failed])
+    out.writerow(["label", "seed", "episodes"] + KINDS + ["failed_actions"])
+    out.writerow([args.label, args.seed, len(agent)] + [kinds[k] for k in KINDS] + [failed])
 
 
 if __name__ == "__main__":

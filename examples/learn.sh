@@ -233,4 +233,11 @@ touch "$run/actor.done"
 wait $learner || true
 trap - EXIT
 cat "$run"/eval/*.csv | awk 'NR == 1 || !/^label/' > "$run/eval.csv"
+# Where the final networks' agent goes on the evaluation scenes, beside the expert on the same
+# scenes (failure_reasons.sh: the last evaluation's episodes again, deterministic).
+if [ ! -f "$run/failures.csv" ]; then
+  VARIATION=$VARIATION EVAL_SEED=$EVAL_SEED bash "$(dirname "$0")/failure_reasons.sh" "$task" "$run/eval/checkpoint.rec" \
+    "$ACT_K" "$IMAGE" "$EVAL_EPISODES" "$LABEL" "$SEED" $act_branching > "$run/failures.csv.tmp" 2>> "$run/actor.log" \
+    && mv "$run/failures.csv.tmp" "$run/failures.csv" || log "$task $LABEL seed $SEED: no failure analysis (see actor.log)"
+fi
 log "$task $LABEL seed $SEED: done; $run/eval.csv"
