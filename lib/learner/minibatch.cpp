@@ -1,6 +1,8 @@
 #include "learner/minibatch.hpp"
 
 #include <cmath>
+#include <map>
+#include <utility>
 
 #include "qattention/proprio.hpp"
 #include "voxels/grid_fields.hpp"
@@ -42,6 +44,7 @@ Minibatch assemble_minibatch(const replay::ReplayBuffer& replay, const replay::S
   const int v = h.voxels(), depths = h.depths;
   const std::size_t grid_floats = static_cast<std::size_t>(v) * v * v * voxels::kChannels;
   Minibatch b;
+  std::map<std::pair<const stream::Record*, int32_t>, int64_t> next_states;  // (frame, step) -> id
   b.size = static_cast<int>(sample.indices.size());
   b.indices = sample.indices;
   b.weights = sample.weights;
@@ -83,8 +86,10 @@ Minibatch assemble_minibatch(const replay::ReplayBuffer& replay, const replay::S
     b.reward.push_back(static_cast<float>(reward));
     b.discount.push_back(static_cast<float>(discount));
     const stream::Record& next = replay.next_frame_of(last);
+    const int32_t next_step = replay.transition(last).scalar<int32_t>("step") + 1;
     b.next_clouds.push_back(voxels::observation_cloud(next));
-    b.next_proprio.push_back(qattention::proprio_of(next, replay.transition(last).scalar<int32_t>("step") + 1));
+    b.next_proprio.push_back(qattention::proprio_of(next, next_step));
+    b.next_state.push_back(next_states.emplace(std::pair{&next, next_step}, next_states.size()).first->second);
   }
   return b;
 }

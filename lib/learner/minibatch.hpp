@@ -24,6 +24,9 @@ struct Minibatch {
   std::vector<float> discount;              // gamma^n, or 0 when the chain ends within n steps
   std::vector<voxels::ObservationCloud> next_clouds;
   std::vector<std::vector<float>> next_proprio;
+  // Which samples reach the same next state (the same stored frame at the same step): equal
+  // ids, so their bootstrap values are computed once. Empty: every sample its own state.
+  std::vector<int64_t> next_state;
   std::vector<double> weights;              // importance weights
   std::vector<std::size_t> indices;         // replay indices
 };

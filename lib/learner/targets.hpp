@@ -8,6 +8,8 @@
 //     with the online networks ranking the top-K voxels of every non-leaf grid and the target
 //     networks valuing them; depth d's Q' is the path's value at d, (q_d + Q'_{d+1}) / 2, the
 //     leaf's the target network's Q of its voxel (C2F-ARM+QTE, Algorithm 2).
+// Each next state is evaluated once: a sample whose chain ended (discount 0) needs none, and
+// samples reaching the same state (Minibatch::next_state) share its value.
 #pragma once
 
 #include <vector>
@@ -23,7 +25,8 @@ struct Targets {
   std::vector<std::vector<float>> translation;  // [depth][B]
   std::vector<float> rotation;                  // [B, 3]
   std::vector<float> gripper;                   // [B]
-  std::vector<double> mean_branches;            // per non-leaf depth: the tree's mean over the batch (none without a tree)
+  std::vector<double> mean_branches;            // per non-leaf depth: the trees' mean over the samples that
+                                                // bootstrap (none without a tree)
 };
 
 Targets bootstrap_targets(const qattention::DepthEvaluator& online, const qattention::DepthEvaluator& target,

@@ -252,6 +252,27 @@ TEST(QLearner, NStepReturnsStayInTheirChainWhereChainsShareAFrame) {
   EXPECT_FLOAT_EQ(b.next_proprio[1][3], 1.0f - 2.0f * 2 / 9);  // the time input of step 2
 }
 
+// Samples that reach the same frame at the same step reach the same state (one id: the targets
+// evaluate it once); the same frame at another step is another state (another time input).
+TEST(QLearner, SamplesReachingTheSameFrameAtTheSameStepShareTheirNextState) {
+  learner::LearnerConfig config = small_config();
+  replay::ReplayBuffer replay;
+  const Eigen::Vector3f block(0.1f, -0.2f, 0.78f);
+  for (int32_t f : {0, 5, 10}) replay.add(frame(4, f, block, 220));
+  for (auto [from, step] : {std::pair{0, 0}, std::pair{5, 0}, std::pair{5, 1}}) {  // all three into frame 10
+    stream::Record t = transition(config.hierarchy, 4, {0.1, -0.2, 0.8}, false);
+    t.set_scalar<int32_t>("frame", from);
+    t.set_scalar<int32_t>("next_frame", 10);
+    t.set_scalar<int32_t>("step", step);
+    replay.add(t);
+  }
+  const learner::Minibatch b = learner::assemble_minibatch(replay, replay::Sample{{0, 1, 2, 0}, {1, 1, 1, 1}}, config);
+  ASSERT_EQ(b.next_state.size(), 4u);
+  EXPECT_EQ(b.next_state[0], b.next_state[1]);  // frame 10 at step 1
+  EXPECT_EQ(b.next_state[0], b.next_state[3]);  // the same transition twice
+  EXPECT_NE(b.next_state[0], b.next_state[2]);  // frame 10 at step 2
+}
+
 namespace {
 
 std::vector<float> gradient_values(const std::vector<nets::QAttentionNet>& nets, int depth) {

@@ -176,3 +176,40 @@ TEST(BootstrapTargets, AdaptiveTreeTargetBetweenKOneAndKMax) {
   Case none(2, 0);
   EXPECT_TRUE(learner::bootstrap_targets(online, target, none.config, none.batch).mean_branches.empty());
 }
+
+// Each next state is evaluated once: samples that reach the same state (the same next_state id)
+// share its trees, a sample whose chain ended (discount 0) needs none, and the targets are
+// those of every sample evaluated on its own.
+TEST(BootstrapTargets, EachNextStateIsEvaluatedOnce) {
+  int online_grids = 0, target_grids = 0;
+  const DepthEvaluator plain_online = test_support::content_q(0.0f), plain_target = test_support::content_q(1.3f);
+  const DepthEvaluator online = [&](int depth, const float* g, const float* p, int batch) {
+    online_grids += batch;
+    return plain_online(depth, g, p, batch);
+  };
+  const DepthEvaluator target = [&](int depth, const float* g, const float* p, int batch) {
+    target_grids += batch;
+    return plain_target(depth, g, p, batch);
+  };
+  Case c(2, 3);
+  // Four samples: 0 and 3 reach the same state with other rewards and discounts, 1 its own, 2 ends.
+  c.batch.size = 4;
+  c.batch.next_clouds.push_back(c.batch.next_clouds[0]);
+  c.batch.next_proprio.push_back(c.batch.next_proprio[0]);
+  c.batch.reward = {0, 0, 100, 30};
+  c.batch.discount = {0.99f, 0.5f, 0, 0.9f};
+  c.batch.next_state = {7, 8, 9, 7};
+  const learner::Targets shared = learner::bootstrap_targets(online, target, c.config, c.batch);
+  EXPECT_EQ(online_grids, 2 * (1 + 3));  // two states, each a root and 3 branches
+  EXPECT_EQ(target_grids, 2 * (1 + 3));
+
+  learner::Minibatch apart = c.batch;  // every sample its own state, none skipped
+  apart.next_state.clear();
+  apart.discount[2] = 0.25f;
+  const learner::Targets alone = learner::bootstrap_targets(plain_online, plain_target, c.config, apart);
+  for (int i : {0, 1, 3})
+    for (int d = 0; d < 2; ++d) EXPECT_FLOAT_EQ(shared.translation[d][i], alone.translation[d][i]) << i;
+  EXPECT_FLOAT_EQ(shared.translation[0][3], 0.3f + 0.9f * (alone.translation[0][0] / 0.99f));
+  for (int d = 0; d < 2; ++d) EXPECT_FLOAT_EQ(shared.translation[d][2], 1.0f);  // the scaled reward alone
+  EXPECT_EQ(shared.mean_branches, std::vector<double>{3.0});
+}
