@@ -9,12 +9,16 @@
 // Options: --arch light|arm, --batch B, --tree-target K, --steps N, --threads N.
 //   --compare K: instead, full steps with plain (double-DQN) and tree-expanded (K) targets
 //   interleaved step by step, so that a noisy machine hits both alike; prints the ratio.
+//   --every-sample-bootstraps 1: every sample its own next state (discount gamma, no shared
+//   states), the targets' worst case; by default the demonstrations' chains end and share
+//   keyframes, and the targets evaluate each next state once (the mean count is printed).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <memory>
 #include <random>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -28,6 +32,15 @@ using Clock = std::chrono::steady_clock;
 
 static double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
+// The next states a minibatch's targets evaluate: one per distinct state among the samples
+// that bootstrap (learner/targets.cpp).
+static int next_states_evaluated(const learner::Minibatch& mb) {
+  std::set<int64_t> states;
+  for (int i = 0; i < mb.size; ++i)
+    if (mb.discount[i] != 0) states.insert(mb.next_state.empty() ? -1 - i : mb.next_state[i]);
+  return static_cast<int>(states.size());
+}
+
 static double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0 : v[v.size() / 2];
@@ -36,7 +49,7 @@ static double median(std::vector<double> v) {
 int main(int argc, char** argv) {
   qte::nets::prepare_process_for_networks(argv);  // fair figures while other programs run
   std::string arch = "light";
-  int batch = 32, tree = 0, steps = 5, threads = 2, compare = 0;
+  int batch = 32, tree = 0, steps = 5, threads = 2, compare = 0, every_sample = 0;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     if (a == "--arch") arch = argv[i + 1];
@@ -45,6 +58,7 @@ int main(int argc, char** argv) {
     else if (a == "--steps") steps = std::atoi(argv[i + 1]);
     else if (a == "--threads") threads = std::atoi(argv[i + 1]);
     else if (a == "--compare") compare = std::atoi(argv[i + 1]);
+    else if (a == "--every-sample-bootstraps") every_sample = std::atoi(argv[i + 1]);
   }
   nets::set_torch_threads(threads);
   nets::seed_torch(1);
@@ -81,15 +95,25 @@ int main(int argc, char** argv) {
       nets::seed_torch(1);
       variants.push_back({k == 0 ? "plain targets" : "tree targets", k, std::make_unique<learner::QLearner>(c), {}});
     }
+    double states = 0;  // next states the targets evaluate, summed over the timed steps
     for (int step = 0; step <= steps; ++step)  // step 0 warms up
       for (Variant& v : variants) {
         std::mt19937_64 rng(step);
         const auto t0 = Clock::now();
         const replay::Sample sample = replay.sample(batch, 1.0, rng);
-        v.learner->train_step(learner::assemble_minibatch(replay, sample, config));
-        if (step > 0) v.seconds.push_back(since(t0));
+        learner::Minibatch mb = learner::assemble_minibatch(replay, sample, config);
+        if (every_sample) {
+          mb.discount.assign(mb.size, static_cast<float>(config.gamma));
+          mb.next_state.clear();
+        }
+        v.learner->train_step(mb);
+        if (step == 0) continue;
+        v.seconds.push_back(since(t0));
+        if (v.tree > 0) states += next_states_evaluated(mb);
       }
-    std::printf("%s batch %d, %d threads, full steps interleaved, median of %d:\n", arch.c_str(), batch, threads, steps);
+    std::printf("%s batch %d, %d threads, full steps interleaved, median of %d; %.1f next states evaluated per batch%s:\n",
+                arch.c_str(), batch, threads, steps, states / steps,
+                every_sample ? " (every sample its own)" : " (chains that end need none, shared ones once)");
     for (const Variant& v : variants)
       std::printf("  %-14s K=%-2d %.3f s  (%.2fx plain)\n", v.name, v.tree, median(v.seconds),
                   median(v.seconds) / median(variants[0].seconds));
