@@ -135,7 +135,9 @@ stream::Record frame_record(const stream::Record& obs, int64_t episode_key) {
   for (const auto& field : obs.fields()) {
     const std::string& name = field.name();
     if (stream::ends_with(name, ".rgb")) {
-      frame.set_raw(name, field.dtype(), field.shape(), field.bytes(), /*compress=*/true);
+      stream::Field rgb = field;  // read compressed: its zstd frame is written as it came
+      rgb.compress = true;
+      frame.add(rgb);
     } else if (stream::ends_with(name, ".depth")) {
       // Millimetres in 16 bits: 0.5 mm rounding, far below a 1.9 cm voxel, half the bytes.
       const auto depth = obs.array<float>(name);

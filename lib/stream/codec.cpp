@@ -204,7 +204,8 @@ Record decode_payload(const RecordHeader& header, std::shared_ptr<const uint8_t>
       const std::shared_ptr<uint8_t> owner =
           decompressed(data, stored, raw_bytes, max_field_bytes, "'" + name + "': ", bad);
       Field field(name, dtype, shape, owner, owner.get());
-      field.compress = true;  // written again compressed when passed through
+      field.compress = true;  // written again compressed when passed through: this very frame
+      field.keep_encoded(payload, data, stored);
       record.add(std::move(field));
     }
     at += pad64(stored);  // within the payload: stored <= size - at and sizes are 64-multiples
@@ -227,7 +228,10 @@ std::vector<uint8_t> encode_record(const Record& record, int zstd_level) {
   std::size_t payload = 0;
   for (const Field& f : record.fields()) {
     Piece piece{&f, Encoding::raw, {}};
-    if (f.compress && f.byte_count() >= 256) {
+    if (f.compress && f.encoded()) {  // read compressed and passed on: its frame as it was
+      piece.compressed.assign(f.encoded(), f.encoded() + f.encoded_size());
+      piece.encoding = Encoding::zstd;
+    } else if (f.compress && f.byte_count() >= 256) {
       piece.compressed.resize(ZSTD_compressBound(f.byte_count()));
       const std::size_t n = ZSTD_compress(piece.compressed.data(), piece.compressed.size(),
                                           f.bytes(), f.byte_count(), zstd_level);

@@ -45,12 +45,27 @@ class Field {
   // Ask the writer to zstd-compress this array (kept raw when that does not shrink it).
   bool compress = false;
 
+  // The zstd frame these elements were read from (null when they were stored raw or made
+  // here). A writer asked to compress them writes this frame again instead of compressing
+  // anew: the same bytes when it was written at the writer's level (every program here
+  // writes level 3), and no work in the programs that pass observations on.
+  void keep_encoded(std::shared_ptr<const void> owner, const uint8_t* frame, std::size_t size) {
+    encoded_owner_ = std::move(owner);
+    encoded_ = frame;
+    encoded_size_ = size;
+  }
+  const uint8_t* encoded() const { return encoded_; }
+  std::size_t encoded_size() const { return encoded_size_; }
+
  private:
   std::string name_;
   DType dtype_;
   Shape shape_;
   std::shared_ptr<const void> owner_;  // keeps `bytes_` alive (a read payload or own buffer)
   const uint8_t* bytes_;
+  std::shared_ptr<const void> encoded_owner_;  // keeps `encoded_` alive (the read payload)
+  const uint8_t* encoded_ = nullptr;
+  std::size_t encoded_size_ = 0;
 };
 
 class Record {

@@ -103,6 +103,36 @@ TEST(Codec, CompressedFieldsRoundTripAndShrink) {
   EXPECT_TRUE(out[0].field("depth_mm").compress);
 }
 
+// A field read compressed is written again with the frame it came in, not compressed anew:
+// the same bytes at the same level, and (shown with a frame of another level) no new frame.
+TEST(Codec, CompressedFieldsPassedOnKeepTheirFrame) {
+  Record r("obs");
+  std::vector<uint16_t> depth(128 * 128);
+  for (std::size_t i = 0; i < depth.size(); ++i) depth[i] = static_cast<uint16_t>(800 + (i * 7919) % 1000);
+  r.set<uint16_t>("depth_mm", {128, 128}, depth, /*compress=*/true);
+  r.set_string("task", "reach_prism");
+  const auto level3 = encode_record(r);
+  EXPECT_EQ(encode_record(read_all(level3).at(0)), level3);
+  const auto other = encode_record(r, -5);  // zstd's fast mode: another frame for the same elements
+  ASSERT_NE(other, level3);
+  Record passed = read_all(other).at(0);
+  EXPECT_NE(passed.field("depth_mm").encoded(), nullptr);
+  EXPECT_EQ(encode_record(passed, 3), other);  // written as it came
+  passed.set_string("task", "pick_and_lift");  // other fields may change around it
+  const auto changed = read_all(encode_record(passed, 3)).at(0);
+  const auto view = changed.array<uint16_t>("depth_mm");
+  EXPECT_TRUE(std::equal(view.begin(), view.end(), depth.begin()));
+  // Elements made anew (set) are compressed anew.
+  Record fresh = passed;
+  fresh.set<uint16_t>("depth_mm", {128, 128}, depth, /*compress=*/true);
+  EXPECT_EQ(fresh.field("depth_mm").encoded(), nullptr);
+  EXPECT_EQ(encode_record(fresh, 3).size(), encode_record([&] {
+              Record x = r;
+              x.set_string("task", "pick_and_lift");
+              return x;
+            }(), 3).size());
+}
+
 TEST(Codec, ReadsConsecutiveRecordsWithOffsets) {
   auto bytes = encode_record(sample_record());
   const std::size_t first = bytes.size();
