@@ -33,20 +33,6 @@ Eigen::Isometry3d to_eigen(const urdf::Pose& pose) {
 
 bool file_exists(const std::string& path) { return std::ifstream(path).good(); }
 
-}  // namespace
-
-std::string default_data_dir() {
-  if (const char* env = std::getenv("QTE_DATA_DIR")) return env;
-  for (const std::string& dir : {std::string(QTE_SOURCE_DATA_DIR), std::string(QTE_INSTALLED_DATA_DIR)})
-    if (!dir.empty() && file_exists(dir + "/xarm7.urdf")) return dir;
-  throw Error("cannot find the robot description xarm7.urdf: set QTE_DATA_DIR to the directory "
-              "that holds it");
-}
-
-RobotModel RobotModel::xarm7() { return load_urdf(default_data_dir() + "/xarm7.urdf"); }
-
-namespace {
-
 // One collision element of a link: a box, cylinder or sphere placed in the link's frame.
 Shape shape_from(const urdf::Collision& collision, const std::string& path, const std::string& link) {
   Shape shape;
@@ -89,6 +75,16 @@ Joint joint_from(const urdf::Joint& joint, const std::string& path) {
 }
 
 }  // namespace
+
+std::string default_data_dir() {
+  if (const char* env = std::getenv("QTE_DATA_DIR")) return env;
+  for (const std::string& dir : {std::string(QTE_SOURCE_DATA_DIR), std::string(QTE_INSTALLED_DATA_DIR)})
+    if (!dir.empty() && file_exists(dir + "/xarm7.urdf")) return dir;
+  throw Error("cannot find the robot description xarm7.urdf: set QTE_DATA_DIR to the directory "
+              "that holds it");
+}
+
+RobotModel RobotModel::xarm7() { return load_urdf(default_data_dir() + "/xarm7.urdf"); }
 
 RobotModel RobotModel::load_urdf(const std::string& path) {
   std::ifstream in(path);
