@@ -1,0 +1,71 @@
+#!/usr/bin/env python3
+"""examples/failure_reasons.py sorts episodes by where the agent went: checked on a scene built
+here by hand (three objects of points on the table, the expert over the first) against the rule
+it documents: success; a distractor (the object it went for is not the expert's); the target
+missed; elsewhere (over 4 cm from every object); the first closing pose decides a grasp; and a
+table without objects. Run with Debian's python3 (NumPy)."""
+import os
+import sys
+
+import numpy as np
+
+SOURCE = os.environ.get("QTE_SOURCE") or os.path.join(os.path.dirname(__file__), "..", "..")
+sys.path.insert(0, os.path.join(SOURCE, "examples"))
+import failure_reasons as fr  # noqa: E402
+from qte_stream import Record  # noqa: E402  (failure_reasons put lib/python on the path)
+
+TABLE = fr.objects.__globals__["TABLE_Z"]
+OBJECTS = [np.array([0.10, -0.10]), np.array([0.20, 0.05]), np.array([0.05, 0.15])]  # the target first
+
+
+def points(with_objects=True):
+    """A 20 x 20 'image' of points: the table, and 30 points 2 cm above it around each object."""
+    rng = np.random.default_rng(1)
+    xyz = np.column_stack([rng.uniform(-0.05, 0.35, 400), rng.uniform(-0.3, 0.3, 400), np.full(400, TABLE)])
+    if with_objects:
+        for k, centre in enumerate(OBJECTS):
+            xyz[k * 30:(k + 1) * 30, :2] = centre + rng.uniform(-0.01, 0.01, (30, 2))
+            xyz[k * 30:(k + 1) * 30, 2] = TABLE + 0.02
+    return xyz.reshape(20, 20, 3).astype(np.float32)
+
+
+def obs(step, xy=(0.0, 0.0), gripper_open=1, success=0, failure="", with_objects=True):
+    fields = {"front.points": points(with_objects), "gripper_pose": np.array([xy[0], xy[1], TABLE + 0.1, 1, 0, 0, 0]),
+              "gripper_open": np.array(gripper_open, np.uint8), "step": np.array(step, np.int32),
+              "success": np.array(success, np.uint8)}
+    if failure:
+        fields["failure"] = failure
+    return Record("obs", fields, 0, 0)
+
+
+def action(xy, gripper_open=1):
+    return Record("action", {"pose": np.array([xy[0], xy[1], TABLE + 0.03, 1, 0, 0, 0]),
+                             "gripper_open": np.array(gripper_open, np.uint8)}, 0, 0)
+
+
+def episode(actions, **last):
+    return {"obs": [obs(0)] + [obs(i + 1) for i in range(len(actions) - 1)] + [obs(len(actions), **last)],
+            "actions": actions}
+
+
+expert = [obs(0), obs(0, OBJECTS[0]), obs(1, OBJECTS[0], success=1)]
+cases = [
+    ("success", episode([action(OBJECTS[0])], success=1)),
+    ("distractor", episode([action(OBJECTS[1] + 0.01)])),
+    ("target", episode([action(OBJECTS[0])], failure="goal_in_collision: the gripper in the table")),
+    ("elsewhere", episode([action(OBJECTS[2] + 0.05)])),  # 5 cm from the nearest object
+    ("distractor", episode([action(OBJECTS[0]), action(OBJECTS[2], gripper_open=0), action(OBJECTS[0])])),
+    ("target", episode([action(OBJECTS[2]), action(OBJECTS[0])])),  # no grasp: the last pose decides
+]
+failures = []
+for want, agent in cases:
+    kind, distance, failure = fr.classify(expert, agent)
+    if kind != want:
+        failures.append(f"expected {want}, got {kind} ({100 * distance:.1f} cm)")
+kind, _, _ = fr.classify([obs(0, with_objects=False)], {"obs": [obs(0, with_objects=False), obs(1, success=1)],
+                                                        "actions": [action(OBJECTS[0])]})
+if kind != "success":
+    failures.append(f"a table without objects: expected success, got {kind}")
+if failures:
+    sys.exit("FAIL: " + "; ".join(failures))
+print(f"failure reasons ok: {len(cases) + 1} episodes sorted as the rule says")
