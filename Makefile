@@ -40,7 +40,7 @@ check-slow: build
 # The cluster tests: a throwaway single-node Slurm cluster (Debian's slurm-wlm and munge, from
 # debian-packages-slurm.txt) runs an experiment grid and a split run (tests/slurm/).
 check-slurm: build
-	$(MAKE) deps APT_PACKAGES="$$(sed -e 's/#.*//' debian-packages-slurm.txt)"
+	$(MAKE) deps APT_PACKAGES="$$(sed -e 's/#.*//' debian-packages-slurm.txt | tr '\n' ' ')"
 	ctest --test-dir $(BUILD) --output-on-failure -L slurm
 
 demo: build
