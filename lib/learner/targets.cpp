@@ -36,6 +36,8 @@ NextStates next_states(const Minibatch& batch) {
 
 }  // namespace
 
+int next_states_evaluated(const Minibatch& batch) { return static_cast<int>(next_states(batch).clouds.size()); }
+
 Targets bootstrap_targets(const qattention::DepthEvaluator& online, const qattention::DepthEvaluator& target,
                           const LearnerConfig& config, const Minibatch& batch) {
   const int depths = config.hierarchy.depths, n = batch.size;

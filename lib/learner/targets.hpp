@@ -29,6 +29,9 @@ struct Targets {
                                                 // bootstrap (none without a tree)
 };
 
+// How many next states bootstrap_targets evaluates for `batch` (for benchmarks and metrics).
+int next_states_evaluated(const Minibatch& batch);
+
 Targets bootstrap_targets(const qattention::DepthEvaluator& online, const qattention::DepthEvaluator& target,
                           const LearnerConfig& config, const Minibatch& batch);
 

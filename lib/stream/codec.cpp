@@ -221,40 +221,41 @@ std::vector<uint8_t> encode_record(const Record& record, int zstd_level) {
   // Compress first, so the payload size is known before anything is laid out.
   struct Piece {
     const Field* field;
-    Encoding encoding;
-    std::vector<uint8_t> compressed;
+    Encoding encoding = Encoding::raw;
+    std::vector<uint8_t> compressed;  // a frame made here
+    const uint8_t* data = nullptr;    // what is stored: the field's bytes, its kept frame or `compressed`
+    std::size_t stored = 0;
   };
-  std::vector<Piece> pieces;
+  std::vector<Piece> pieces(record.fields().size());
   std::size_t payload = 0;
-  for (const Field& f : record.fields()) {
-    Piece piece{&f, Encoding::raw, {}};
+  for (std::size_t k = 0; k < pieces.size(); ++k) {
+    const Field& f = record.fields()[k];
+    Piece& piece = pieces[k];
+    piece.field = &f;
+    piece.data = f.bytes();
+    piece.stored = f.byte_count();
     if (f.compress && f.encoded()) {  // read compressed and passed on: its frame as it was
-      piece.compressed.assign(f.encoded(), f.encoded() + f.encoded_size());
       piece.encoding = Encoding::zstd;
+      piece.data = f.encoded();
+      piece.stored = f.encoded_size();
     } else if (f.compress && f.byte_count() >= 256) {
       piece.compressed.resize(ZSTD_compressBound(f.byte_count()));
       const std::size_t n = ZSTD_compress(piece.compressed.data(), piece.compressed.size(),
                                           f.bytes(), f.byte_count(), zstd_level);
-      if (!ZSTD_isError(n) && n < f.byte_count()) {
-        piece.compressed.resize(n);
+      if (!ZSTD_isError(n) && n < f.byte_count()) {  // kept raw when that does not shrink it
         piece.encoding = Encoding::zstd;
-      } else {
-        piece.compressed.clear();
+        piece.data = piece.compressed.data();
+        piece.stored = n;
       }
     }
-    const std::size_t stored =
-        piece.encoding == Encoding::zstd ? piece.compressed.size() : f.byte_count();
-    payload += pad64(kDescriptorFixedBytes + 8 * f.shape().size() + f.name().size()) +
-               pad64(stored);
-    pieces.push_back(std::move(piece));
+    payload += pad64(kDescriptorFixedBytes + 8 * f.shape().size() + f.name().size()) + pad64(piece.stored);
   }
 
   std::vector<uint8_t> out(kHeaderBytes + payload, 0);
   uint8_t* p = out.data() + kHeaderBytes;
   for (const Piece& piece : pieces) {
     const Field& f = *piece.field;
-    const bool zstd = piece.encoding == Encoding::zstd;
-    const std::size_t stored = zstd ? piece.compressed.size() : f.byte_count();
+    const std::size_t stored = piece.stored;
     p[0] = static_cast<uint8_t>(f.dtype());
     p[1] = static_cast<uint8_t>(f.shape().size());
     p[2] = static_cast<uint8_t>(piece.encoding);
@@ -265,7 +266,7 @@ std::vector<uint8_t> encode_record(const Record& record, int zstd_level) {
     std::memcpy(p + kDescriptorFixedBytes + 8 * f.shape().size(), f.name().data(),
                 f.name().size());
     p += pad64(kDescriptorFixedBytes + 8 * f.shape().size() + f.name().size());
-    if (stored) std::memcpy(p, zstd ? piece.compressed.data() : f.bytes(), stored);
+    if (stored) std::memcpy(p, piece.data, stored);
     p += pad64(stored);
   }
 

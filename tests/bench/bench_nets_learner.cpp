@@ -18,28 +18,19 @@
 #include <cstring>
 #include <memory>
 #include <random>
-#include <set>
 #include <string>
 #include <vector>
 
 #include "demos/demo_recorder.hpp"
 #include "keyframes/transitions.hpp"
 #include "learner/q_learner.hpp"
+#include "learner/targets.hpp"
 #include "replay/replay_buffer.hpp"
 
 using namespace qte;
 using Clock = std::chrono::steady_clock;
 
 static double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-// The next states a minibatch's targets evaluate: one per distinct state among the samples
-// that bootstrap (learner/targets.cpp).
-static int next_states_evaluated(const learner::Minibatch& mb) {
-  std::set<int64_t> states;
-  for (int i = 0; i < mb.size; ++i)
-    if (mb.discount[i] != 0) states.insert(mb.next_state.empty() ? -1 - i : mb.next_state[i]);
-  return static_cast<int>(states.size());
-}
 
 static double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -109,7 +100,7 @@ int main(int argc, char** argv) {
         v.learner->train_step(mb);
         if (step == 0) continue;
         v.seconds.push_back(since(t0));
-        if (v.tree > 0) states += next_states_evaluated(mb);
+        if (v.tree > 0) states += learner::next_states_evaluated(mb);
       }
     std::printf("%s batch %d, %d threads, full steps interleaved, median of %d; %.1f next states evaluated per batch%s:\n",
                 arch.c_str(), batch, threads, steps, states / steps,

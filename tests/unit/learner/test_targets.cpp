@@ -200,6 +200,7 @@ TEST(BootstrapTargets, EachNextStateIsEvaluatedOnce) {
   c.batch.discount = {0.99f, 0.5f, 0, 0.9f};
   c.batch.next_state = {7, 8, 9, 7};
   const learner::Targets shared = learner::bootstrap_targets(online, target, c.config, c.batch);
+  EXPECT_EQ(learner::next_states_evaluated(c.batch), 2);
   EXPECT_EQ(online_grids, 2 * (1 + 3));  // two states, each a root and 3 branches
   EXPECT_EQ(target_grids, 2 * (1 + 3));
 
