@@ -156,7 +156,7 @@ class ArmNet : public QAttentionModule {
     if (config.is_last) h = register_module("h", dense_head(4 * (k + 2 * k + 4 * k + k)));
   }
 
-  QOutputs forward_batch(const torch::Tensor& grid, const torch::Tensor& proprio) override {
+  Trunk trunk_batch(const torch::Tensor& grid, const torch::Tensor& proprio) override {
     const auto x = inp->forward(grid);
     const auto p = tiled(leaky(prop->forward(proprio))).expand({-1, -1, grid.size(2), grid.size(3), grid.size(4)});
     const auto e0 = d0->forward(torch::cat({x, p}, 1));
@@ -164,11 +164,11 @@ class ArmNet : public QAttentionModule {
     const auto e2 = d2->forward(max_pool(e1));
     const auto up1 = u1->forward(torch::cat({e1, u2->forward(e2)}, 1));
     const auto features = leaky(f->forward(torch::cat({e0, up1}, 1)));
-    QOutputs out;
-    out.translation = f2->forward(features).squeeze(1);
-    if (h) split_head(h->forward(pooled_features({e0, e1, e2, features})), out);
+    Trunk out{f2->forward(features).squeeze(1), {}};
+    if (h) out.levels = {e0, e1, e2, features};
     return out;
   }
+  torch::Tensor dense_head_forward(const torch::Tensor& pooled) override { return h->forward(pooled); }
 
   int64_t multiply_accumulates() const override {
     const int64_t v0 = cube(config().voxels), v1 = cube(config().voxels / 2), v2 = cube(config().voxels / 4);
@@ -223,17 +223,17 @@ class LightNet : public QAttentionModule {
     if (config.is_last) head = register_module("head", dense_head(4 * (k + 2 * k + 4 * k + k)));
   }
 
-  QOutputs forward_batch(const torch::Tensor& grid, const torch::Tensor& proprio_in) override {
+  Trunk trunk_batch(const torch::Tensor& grid, const torch::Tensor& proprio_in) override {
     const auto e0 = leaky(input->forward(grid) + tiled(proprio->forward(proprio_in)));
     const auto e1 = down1->forward(max_pool(e0));
     const auto e2 = down2->forward(max_pool(e1));
     const auto d1 = leaky(up1->forward(e1 + upsample(lateral2->forward(e2))));
     const auto d0 = leaky(up0->forward(e0 + upsample(lateral1->forward(d1))));
-    QOutputs out;
-    out.translation = q->forward(d0).squeeze(1);
-    if (head) split_head(head->forward(pooled_features({e0, e1, e2, d0})), out);
+    Trunk out{q->forward(d0).squeeze(1), {}};
+    if (head) out.levels = {e0, e1, e2, d0};
     return out;
   }
+  torch::Tensor dense_head_forward(const torch::Tensor& pooled) override { return head->forward(pooled); }
 
   int64_t multiply_accumulates() const override {
     const int64_t v = config().voxels, v0 = v * v * v, v1 = v0 / 8, v2 = v0 / 64;
@@ -253,10 +253,22 @@ class LightNet : public QAttentionModule {
 }  // namespace
 
 QOutputs QAttentionModule::forward(const torch::Tensor& grid, const torch::Tensor& proprio) {
-  if (grid.size(0) != 1) return forward_batch(grid, proprio);
-  const QOutputs twice = forward_batch(torch::cat({grid, grid}), torch::cat({proprio, proprio}));
-  const auto first = [](const torch::Tensor& t) { return t.defined() ? t.slice(0, 0, 1) : t; };
-  return {first(twice.translation), first(twice.rotation), first(twice.gripper)};
+  const Trunk t = trunk(grid, proprio);
+  QOutputs out{t.translation, {}, {}};
+  if (config_.is_last) heads(t.levels, out);
+  return out;
+}
+
+Trunk QAttentionModule::trunk(const torch::Tensor& grid, const torch::Tensor& proprio) {
+  if (grid.size(0) != 1) return trunk_batch(grid, proprio);
+  Trunk twice = trunk_batch(torch::cat({grid, grid}), torch::cat({proprio, proprio}));
+  twice.translation = twice.translation.slice(0, 0, 1);
+  for (auto& level : twice.levels) level = level.slice(0, 0, 1);
+  return twice;
+}
+
+void QAttentionModule::heads(const std::vector<torch::Tensor>& levels, QOutputs& out) {
+  split_head(dense_head_forward(pooled_features(levels)), out);
 }
 
 std::shared_ptr<QAttentionModule> make_qattention_module(const NetConfig& config) {

@@ -17,6 +17,13 @@ struct QOutputs {
   torch::Tensor gripper;      // [B, 2]; undefined unless the config is_last
 };
 
+// The convolutional part of a forward: translation Q and, at the last depth, the U-Net
+// activations the dense head pools (kept so that the head can run later on some samples only).
+struct Trunk {
+  torch::Tensor translation;           // [B, V, V, V]
+  std::vector<torch::Tensor> levels;   // [B, C_l, ...] per pooled level; empty unless is_last
+};
+
 // One depth's network. Parameter names are those of the architecture's module tree; for
 // `arm` they are exactly those of Net in shared/bench/torch_qattention_ref.py, so Python can
 // load our weights into it by name.
@@ -26,18 +33,24 @@ class QAttentionModule : public torch::nn::Module {
   const NetConfig& config() const { return config_; }
 
   // grid: [B, channels, V, V, V] (channels first: see channels_first), proprio: [B, proprio].
+  // trunk + heads.
+  QOutputs forward(const torch::Tensor& grid, const torch::Tensor& proprio);
   // A batch of one runs as two copies of the sample: LibTorch 1.13 sends batch-1 3D
   // convolutions with 3x3x3 kernels to its vol2col fallback rather than oneDNN, which makes
   // them slower than the same convolutions at batch 2 (measured with PyTorch 1.13 on 2 threads:
   // light 41 ms at batch 1 against 6 ms at batch 2, arm 368 ms against 77 ms).
-  QOutputs forward(const torch::Tensor& grid, const torch::Tensor& proprio);
+  Trunk trunk(const torch::Tensor& grid, const torch::Tensor& proprio);
+  // Rotation and gripper Q values (into `out`) from a trunk's levels, or from rows of them:
+  // pooled features, then the dense head. Row by row the same values as in the whole batch.
+  void heads(const std::vector<torch::Tensor>& levels, QOutputs& out);
 
   // Multiply-accumulates of one sample's forward pass in convolutions and linear layers
   // (element-wise work not counted); x2 for FLOPs, about x3 again for forward + backward.
   virtual int64_t multiply_accumulates() const = 0;
 
  protected:
-  virtual QOutputs forward_batch(const torch::Tensor& grid, const torch::Tensor& proprio) = 0;
+  virtual Trunk trunk_batch(const torch::Tensor& grid, const torch::Tensor& proprio) = 0;
+  virtual torch::Tensor dense_head_forward(const torch::Tensor& pooled) = 0;
 
  private:
   NetConfig config_;

@@ -47,16 +47,61 @@ int64_t QAttentionNet::parameter_count() const {
   return count;
 }
 
+namespace {
+
+void append(std::vector<float>& to, const torch::Tensor& t) {
+  const auto c = t.contiguous();
+  to.insert(to.end(), c.data_ptr<float>(), c.data_ptr<float>() + c.numel());
+}
+
+// Rows' rotation and gripper Q values into the [batch, ...] arrays of `into` (zeros elsewhere),
+// from the trunks of predict_leaves's chunks.
+void heads_of_rows(QAttentionModule& module, const std::vector<Trunk>& chunks, int batch, const std::vector<int>& rows,
+                   QValues& into) {
+  constexpr int kRotations = kRotationAxes * kRotationBins;
+  into.rotation.assign(static_cast<std::size_t>(batch) * kRotations, 0.0f);
+  into.gripper.assign(static_cast<std::size_t>(batch) * kGripperActions, 0.0f);
+  torch::NoGradGuard no_grad;
+  for (std::size_t c = 0; c < chunks.size(); ++c) {
+    const int first = static_cast<int>(c) * kPredictChunk;
+    std::vector<int64_t> local;
+    std::vector<int> wanted;
+    for (int row : rows) {
+      if (row < 0 || row >= batch) throw Error("network heads asked for row " + std::to_string(row) + " of " + std::to_string(batch));
+      if (row >= first && row < first + kPredictChunk) local.push_back(row - first), wanted.push_back(row);
+    }
+    if (local.empty()) continue;
+    const auto index = torch::tensor(local, torch::kLong);
+    std::vector<torch::Tensor> levels;
+    for (const auto& level : chunks[c].levels) levels.push_back(level.index_select(0, index));
+    QOutputs out;
+    module.heads(levels, out);
+    const auto rotation = out.rotation.contiguous(), gripper = out.gripper.contiguous();
+    for (std::size_t i = 0; i < wanted.size(); ++i) {
+      std::copy_n(rotation.data_ptr<float>() + i * kRotations, kRotations, into.rotation.begin() + wanted[i] * kRotations);
+      std::copy_n(gripper.data_ptr<float>() + i * kGripperActions, kGripperActions,
+                  into.gripper.begin() + wanted[i] * kGripperActions);
+    }
+  }
+}
+
+}  // namespace
+
 QValues QAttentionNet::predict(const float* grids, const float* proprio, int batch) const {
+  return predict_chunks(grids, proprio, batch, true);
+}
+
+QValues QAttentionNet::predict_leaves(const float* grids, const float* proprio, int batch) const {
+  return predict_chunks(grids, proprio, batch, !config_.is_last);
+}
+
+QValues QAttentionNet::predict_chunks(const float* grids, const float* proprio, int batch, bool heads_now) const {
   const int64_t v = config_.voxels;
   const std::size_t grid_floats = static_cast<std::size_t>(v * v * v * config_.channels);
   torch::NoGradGuard no_grad;
   QValues values;
   values.batch = batch;
-  const auto append = [](std::vector<float>& to, const torch::Tensor& t) {
-    const auto c = t.contiguous();
-    to.insert(to.end(), c.data_ptr<float>(), c.data_ptr<float>() + c.numel());
-  };
+  auto kept = std::make_shared<std::vector<Trunk>>();
   // Large batches (tree-expanded targets: batch x K grids) go through in chunks: LibTorch's
   // 3D convolutions cost more per sample beyond a few dozen samples (measured with light:
   // 2.3 ms per sample at 32-128, 4.1 ms at 352).
@@ -66,11 +111,23 @@ QValues QAttentionNet::predict(const float* grids, const float* proprio, int bat
     const auto grid = torch::from_blob(const_cast<float*>(grids + first * grid_floats), {n, v, v, v, config_.channels});
     const auto state = torch::from_blob(const_cast<float*>(proprio + static_cast<std::size_t>(first) * config_.proprio),
                                         {n, config_.proprio});
-    const QOutputs out = module_->forward(channels_first(grid), state);
-    append(values.translation, out.translation);
-    if (out.rotation.defined()) append(values.rotation, out.rotation);
-    if (out.gripper.defined()) append(values.gripper, out.gripper);
+    Trunk trunk = module_->trunk(channels_first(grid), state);
+    append(values.translation, trunk.translation);
+    if (!config_.is_last) continue;
+    if (heads_now) {
+      QOutputs out;
+      module_->heads(trunk.levels, out);
+      append(values.rotation, out.rotation);
+      append(values.gripper, out.gripper);
+    } else {
+      trunk.translation = torch::Tensor();  // copied out above; only the levels wait
+      kept->push_back(std::move(trunk));
+    }
   }
+  if (config_.is_last && !heads_now)
+    values.heads_for = [module = module_, kept, batch](const std::vector<int>& rows, QValues& into) {
+      heads_of_rows(*module, *kept, batch, rows, into);
+    };
   return values;
 }
 
@@ -87,19 +144,24 @@ std::vector<QAttentionNet> make_coarse_to_fine_nets(NetConfig config, int depths
 
 void seed_torch(uint64_t seed) { torch::manual_seed(seed); }
 
-void prepare_process_for_networks(char** argv) {
-  if (std::getenv("OMP_WAIT_POLICY") == nullptr) {
-    ::setenv("OMP_WAIT_POLICY", "PASSIVE", 1);
-    // By its own path, so that the process keeps its name (ps, pgrep, perf: "qte-select", not
-    // "exe"); failing that, through /proc; failing both, carry on with spinning waits.
-    char self[4096];
-    const ssize_t length = ::readlink("/proc/self/exe", self, sizeof self - 1);
-    if (length > 0) {
-      self[length] = '\0';
-      ::execv(self, argv);
-    }
-    ::execv("/proc/self/exe", argv);
+namespace {
+char** program_arguments = nullptr;  // kept by prepare_process_for_networks for the re-execution
+
+// Executes this program again with the same arguments (by its own path, so that it keeps its
+// name for ps, pgrep and perf: "qte-select", not "exe"); returns only if that fails.
+void execute_again() {
+  char self[4096];
+  const ssize_t length = ::readlink("/proc/self/exe", self, sizeof self - 1);
+  if (length > 0) {
+    self[length] = '\0';
+    ::execv(self, program_arguments);
   }
+  ::execv("/proc/self/exe", program_arguments);
+}
+}  // namespace
+
+void prepare_process_for_networks(char** argv) {
+  program_arguments = argv;
   // A forward allocates and frees megabytes of activations. glibc maps blocks that large
   // with mmap and trims the heap on free, so every forward faulted its pages in anew: acting
   // with K = 10 on one thread spent 2.5 s of system time in 67 actions, as much again as
@@ -111,6 +173,12 @@ void prepare_process_for_networks(char** argv) {
 
 void set_torch_threads(int threads) {
   if (threads < 1) throw Error("torch threads must be >= 1, got " + std::to_string(threads));
+  // One thread starts no OpenMP workers, so only more than one needs passive waits; failing
+  // the re-execution, carry on with spinning waits.
+  if (threads > 1 && program_arguments != nullptr && std::getenv("OMP_WAIT_POLICY") == nullptr) {
+    ::setenv("OMP_WAIT_POLICY", "PASSIVE", 1);
+    execute_again();
+  }
   torch::set_num_threads(threads);
 }
 

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -50,6 +51,9 @@ struct QValues {
   std::vector<float> translation;  // [batch, voxels, voxels, voxels], index order x, y, z
   std::vector<float> rotation;     // [batch, 3, 72] (last depth only, otherwise empty)
   std::vector<float> gripper;      // [batch, 2] (last depth only, otherwise empty)
+  // Set by predict_leaves instead of `rotation` and `gripper`: computes those two for `rows`
+  // only (the other rows hold 0) from the activations it keeps.
+  std::function<void(const std::vector<int>& rows, QValues& into)> heads_for;
 };
 
 class QAttentionModule;  // the torch module (nets/qattention_modules.hpp)
@@ -71,11 +75,18 @@ class QAttentionNet {
   // last as voxels::voxelize writes them; `proprio`: [batch, proprio]. Evaluated in chunks of
   // kPredictChunk samples.
   QValues predict(const float* grids, const float* proprio, int batch) const;
+  // The same for the leaves of a tree, which need every grid's translation Q but the dense
+  // head only for the few leaves chosen from them: the head (pooled features and three linear
+  // layers, ~15% of a last-depth forward) waits for `heads_for`, holding the trunk's
+  // activations until the QValues are gone. Without a head (not is_last): predict.
+  QValues predict_leaves(const float* grids, const float* proprio, int batch) const;
 
   QAttentionModule& module() { return *module_; }
   const QAttentionModule& module() const { return *module_; }
 
  private:
+  QValues predict_chunks(const float* grids, const float* proprio, int batch, bool heads_now) const;
+
   NetConfig config_;
   std::shared_ptr<QAttentionModule> module_;
 };
@@ -85,16 +96,18 @@ std::vector<QAttentionNet> make_coarse_to_fine_nets(NetConfig config, int depths
 
 // Seeds torch's CPU generator: the same seed gives the same initial weights.
 void seed_torch(uint64_t seed);
-// Intra-op threads of LibTorch (its default is every core).
+// Intra-op threads of LibTorch (its default is every core). More than one, in a program that
+// called prepare_process_for_networks: unless the user has set OMP_WAIT_POLICY, this sets it
+// to PASSIVE and executes the program again (same arguments), because LibTorch's OpenMP
+// threads spin while they wait for work and libgomp reads the policy only once, when it loads.
+// When two programs share the cores (the learner and the actor of the learning loop on 2
+// cores), a spinning thread takes the core its partner needs: we measured steps 5x and acting
+// 50x slower. One thread starts no workers and is not executed again: a start of LibTorch
+// costs ~0.4 s of processor time, and the actor starts once per chunk of episodes.
 void set_torch_threads(int threads);
 
-// Programs that run networks call this first thing in main().
-// LibTorch's OpenMP threads spin while they wait for work. When two programs share the cores
-// (the learner and the actor of the learning loop on 2 cores), a spinning thread takes the
-// core its partner needs: we measured steps 5x and acting 50x slower. libgomp reads
-// OMP_WAIT_POLICY once, when it loads, so unless the user has set it, this sets it to PASSIVE
-// and executes the program again (same arguments). Then it keeps freed activations in the
-// heap for the next forward (see the .cpp).
+// Programs that run networks call this first thing in main(): it keeps argv for
+// set_torch_threads and keeps freed activations in the heap for the next forward (see the .cpp).
 void prepare_process_for_networks(char** argv);
 
 }  // namespace qte::nets

@@ -182,9 +182,21 @@ Backup back_up(const Trees& trees, int cells) {
   return b;
 }
 
+// The dense heads of the leaves the paths end in, where the evaluators left them for later
+// (QValues::heads_for: a leaf level's heads are needed only for the chosen leaves).
+void heads_of_chosen_leaves(Trees& trees, const std::vector<int>& leaves) {
+  const int leaf = static_cast<int>(trees.levels.size()) - 1;
+  for (nets::QValues* q : {&trees.ranked[leaf], trees.separate_values ? &trees.valued[leaf] : nullptr}) {
+    if (!q || !q->heads_for) continue;
+    q->heads_for(leaves, *q);
+    q->heads_for = nullptr;  // lets the kept activations go
+    check_finite(*q, leaf);
+  }
+}
+
 // Each tree's best path from its root: per depth the voxel, its grid and Q; at the leaf the
 // ranking networks' rotation bins and gripper action; the nodes each depth below the root had.
-std::vector<Choice> best_paths(const Trees& trees, const Backup& backup, int voxels_per_side, std::size_t roots) {
+std::vector<Choice> best_paths(Trees& trees, const Backup& backup, int voxels_per_side, std::size_t roots) {
   const int depths = static_cast<int>(trees.levels.size()), leaf = depths - 1;
   const int cells = voxels_per_side * voxels_per_side * voxels_per_side;
   const std::vector<nets::QValues>& outputs = trees.values();
@@ -193,6 +205,7 @@ std::vector<Choice> best_paths(const Trees& trees, const Backup& backup, int vox
     for (Choice& c : choices) c.branches.push_back(0);
     for (const Node& node : trees.levels[d]) choices[node.observation].branches.back() += 1;
   }
+  std::vector<int> leaves(roots);
   for (std::size_t root = 0; root < roots; ++root) {
     Choice& choice = choices[root];
     choice.expanded_grids = trees.expanded_grids;
@@ -207,7 +220,13 @@ std::vector<Choice> best_paths(const Trees& trees, const Backup& backup, int vox
       choice.q_values.push_back(outputs[d].translation[at + voxel]);
       if (d + 1 < depths) node = backup.best_child[d][node];
     }
-    if (trees.ranked[leaf].rotation.empty()) continue;
+    leaves[root] = node;
+  }
+  heads_of_chosen_leaves(trees, leaves);
+  if (trees.ranked[leaf].rotation.empty()) return choices;
+  for (std::size_t root = 0; root < roots; ++root) {
+    Choice& choice = choices[root];
+    const int node = leaves[root];
     const std::size_t r = static_cast<std::size_t>(node) * nets::kRotationAxes * nets::kRotationBins;
     for (int axis = 0; axis < nets::kRotationAxes; ++axis) {
       const std::size_t at = r + axis * nets::kRotationBins;
@@ -231,13 +250,14 @@ std::vector<Choice> expand_batch(const DepthEvaluator& rank, const DepthEvaluato
   if (clouds.size() != proprios.size() || clouds.empty())
     throw Error("tree expansion needs one proprio vector per point cloud");
   const int v = hierarchy.voxels();
-  const Trees trees = grow(rank, value_of, hierarchy, clouds, proprios, branching);
+  Trees trees = grow(rank, value_of, hierarchy, clouds, proprios, branching);
   return best_paths(trees, back_up(trees, v * v * v), v, clouds.size());
 }
 
 DepthEvaluator network_evaluator(const std::vector<nets::QAttentionNet>& nets) {
+  // The last depth's heads wait until the tree has chosen its leaves (see best_paths).
   return [&nets](int depth, const float* grids, const float* proprio, int batch) {
-    return nets.at(depth).predict(grids, proprio, batch);
+    return nets.at(depth).predict_leaves(grids, proprio, batch);
   };
 }
 

@@ -21,7 +21,8 @@
 namespace qte::qattention {
 
 // Evaluates `batch` grids (channels last, [batch, V, V, V, C]) at `depth` with one proprio
-// vector for all of them; QAttentionNet::predict of that depth's network in production.
+// vector for all of them; QAttentionNet::predict_leaves of that depth's network in production
+// (at the last depth the heads may come later, through QValues::heads_for, for the chosen leaves).
 using DepthEvaluator =
     std::function<nets::QValues(int depth, const float* grids, const float* proprio, int batch)>;
 

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -109,6 +110,43 @@ TEST(QAttentionNet, OutputShapesForBothArchitecturesAndDepths) {
     EXPECT_EQ(out.rotation.sizes(), (torch::IntArrayRef{batch, 3, 72}));
     EXPECT_EQ(out.gripper.sizes(), (torch::IntArrayRef{batch, 2}));
     EXPECT_FALSE(nets.front().module().forward(torch::randn({1, C, V, V, V}), torch::randn({1, 4})).rotation.defined());
+  }
+}
+
+// The leaves of a tree: predict_leaves gives every grid's translation Q at once and the head's
+// values later, for the rows asked for only; they are the floats predict gives those rows, in
+// every chunk of kPredictChunk and for a batch of one (run as two copies).
+TEST(QAttentionNet, HeadsOfChosenLeavesEqualTheWholeBatchs) {
+  for (Architecture architecture : {Architecture::light, Architecture::arm}) {
+    SCOPED_TRACE(architecture_name(architecture));
+    seed_torch(4);
+    const auto nets = make_coarse_to_fine_nets(config_of(architecture, architecture == Architecture::arm ? 8 : 16), 2);
+    for (int batch : {1, kPredictChunk + 9}) {
+      const auto grids = torch::rand({batch, V, V, V, C}), proprio = torch::rand({batch, 4});
+      const QValues all = nets[1].predict(grids.data_ptr<float>(), proprio.data_ptr<float>(), batch);
+      QValues leaves = nets[1].predict_leaves(grids.data_ptr<float>(), proprio.data_ptr<float>(), batch);
+      EXPECT_EQ(leaves.translation, all.translation);
+      EXPECT_TRUE(leaves.rotation.empty());
+      ASSERT_TRUE(leaves.heads_for);
+      const std::vector<int> rows = batch == 1 ? std::vector<int>{0} : std::vector<int>{kPredictChunk + 3, 2, kPredictChunk};
+      leaves.heads_for(rows, leaves);
+      ASSERT_EQ(leaves.rotation.size(), all.rotation.size());
+      ASSERT_EQ(leaves.gripper.size(), all.gripper.size());
+      const int r = kRotationAxes * kRotationBins;
+      for (int row = 0; row < batch; ++row) {
+        const bool asked = std::find(rows.begin(), rows.end(), row) != rows.end();
+        for (int i = 0; i < r; ++i)
+          ASSERT_EQ(leaves.rotation[row * r + i], asked ? all.rotation[row * r + i] : 0.0f) << "row " << row;
+        for (int i = 0; i < kGripperActions; ++i)
+          ASSERT_EQ(leaves.gripper[row * 2 + i], asked ? all.gripper[row * 2 + i] : 0.0f) << "row " << row;
+      }
+      EXPECT_THROW(leaves.heads_for({batch}, leaves), Error);
+    }
+    // Without a head there is nothing to wait for.
+    const auto grid = torch::rand({2, V, V, V, C}), proprio = torch::rand({2, 4});
+    const QValues coarse = nets[0].predict_leaves(grid.data_ptr<float>(), proprio.data_ptr<float>(), 2);
+    EXPECT_FALSE(coarse.heads_for);
+    EXPECT_EQ(coarse.translation, nets[0].predict(grid.data_ptr<float>(), proprio.data_ptr<float>(), 2).translation);
   }
 }
 

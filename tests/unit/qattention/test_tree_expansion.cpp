@@ -190,8 +190,9 @@ Path algorithm2(const DepthEvaluator& evaluate, const voxels::CoarseToFine& hier
 
 // Batched expand and the plain recursion side by side; `exact`: the same floats (a Q function
 // of the grid alone), otherwise equal up to the rounding of batched against single forwards.
-void expect_same_as_algorithm2(const DepthEvaluator& evaluate, int depths, int k, const voxels::PointCloud& cloud,
-                               bool exact) {
+// The recursion evaluates with `reference` (every output of every grid at once).
+void expect_same_as_algorithm2(const DepthEvaluator& evaluate, const DepthEvaluator& reference, int depths, int k,
+                               const voxels::PointCloud& cloud, bool exact) {
   SCOPED_TRACE("depths " + std::to_string(depths) + ", K " + std::to_string(k));
   voxels::CoarseToFine hierarchy;
   hierarchy.depths = depths;
@@ -203,7 +204,7 @@ void expect_same_as_algorithm2(const DepthEvaluator& evaluate, int depths, int k
     return evaluate(depth, grids, p, batch);
   };
   const Choice c = expand(counted, hierarchy, cloud, proprio, k);
-  const Path p = algorithm2(evaluate, hierarchy, cloud, proprio, k, 0, hierarchy.scene, plain_calls);
+  const Path p = algorithm2(reference, hierarchy, cloud, proprio, k, 0, hierarchy.scene, plain_calls);
   int grids = 0;
   for (int d = 0, width = 1; d < depths; ++d, width *= k) grids += width;  // 1 + K + K^2 + ...
   EXPECT_EQ(batched_calls, depths);  // one batched forward per depth
@@ -223,6 +224,11 @@ void expect_same_as_algorithm2(const DepthEvaluator& evaluate, int depths, int k
     EXPECT_NEAR(c.value, p.value, 1e-5);
   EXPECT_EQ(c.rotation_bins, p.rotation_bins);
   EXPECT_EQ(c.gripper_open, p.gripper_open);
+}
+
+void expect_same_as_algorithm2(const DepthEvaluator& evaluate, int depths, int k, const voxels::PointCloud& cloud,
+                               bool exact) {
+  expect_same_as_algorithm2(evaluate, evaluate, depths, k, cloud, exact);
 }
 
 // Points of a small object: a 3 x 3 x 3 lattice, 8 mm apart, around `centre`.
@@ -371,7 +377,44 @@ TEST(TreeExpansion, BatchedEqualsAlgorithmTwoOnRealNetworks) {
   for (int depths : {2, 3}) {
     nets::seed_torch(5 + depths);
     const auto networks = nets::make_coarse_to_fine_nets(config, depths);
-    for (int k : {1, 2, 5}) expect_same_as_algorithm2(network_evaluator(networks), depths, k, cloud.view(), false);
+    // The batched tree defers the last depth's heads to its chosen leaf; the recursion does not.
+    const DepthEvaluator every_output = [&networks](int depth, const float* grids, const float* p, int batch) {
+      return networks.at(depth).predict(grids, p, batch);
+    };
+    for (int k : {1, 2, 5})
+      expect_same_as_algorithm2(network_evaluator(networks), every_output, depths, k, cloud.view(), false);
+  }
+}
+
+// The learner's tree (online networks rank, target networks value) with the last depth's heads
+// deferred to the chosen leaves gives the choices, values and head values of evaluating every
+// head: a batch of several observations, leaf levels over one chunk of kPredictChunk grids.
+TEST(TreeExpansion, DeferredHeadsGiveTheChoicesOfEveryHead) {
+  nets::NetConfig config;
+  nets::seed_torch(11);
+  const auto online = nets::make_coarse_to_fine_nets(config, 2), target = nets::make_coarse_to_fine_nets(config, 2);
+  const auto every_output = [](const std::vector<nets::QAttentionNet>& nets) -> DepthEvaluator {
+    return [&nets](int depth, const float* grids, const float* p, int batch) { return nets.at(depth).predict(grids, p, batch); };
+  };
+  std::vector<voxels::PointCloud> clouds;
+  std::vector<std::vector<float>> proprios;
+  const test_support::RandomCloud a(1, {120, 80, 40}), b(2, {40, 90, 160});
+  for (int i = 0; i < 4; ++i) {
+    clouds.push_back(i % 2 ? a.view() : b.view());
+    proprios.push_back({1, 0.01f * i, 0.04f, 0.5f - 0.1f * i});
+  }
+  voxels::CoarseToFine hierarchy;
+  const auto deferred = expand_batch(network_evaluator(online), network_evaluator(target), hierarchy, clouds, proprios, 10);
+  const auto whole = expand_batch(every_output(online), every_output(target), hierarchy, clouds, proprios, 10);
+  ASSERT_EQ(deferred.size(), whole.size());
+  for (std::size_t i = 0; i < whole.size(); ++i) {
+    EXPECT_EQ(deferred[i].indices, whole[i].indices) << i;
+    EXPECT_EQ(deferred[i].q_values, whole[i].q_values) << i;
+    EXPECT_EQ(deferred[i].value, whole[i].value) << i;
+    EXPECT_EQ(deferred[i].rotation_bins, whole[i].rotation_bins) << i;
+    EXPECT_EQ(deferred[i].rotation_q, whole[i].rotation_q) << i;
+    EXPECT_EQ(deferred[i].gripper_open, whole[i].gripper_open) << i;
+    EXPECT_EQ(deferred[i].gripper_q, whole[i].gripper_q) << i;
   }
 }
 
