@@ -113,6 +113,32 @@ TEST(QAttentionNet, OutputShapesForBothArchitecturesAndDepths) {
   }
 }
 
+// Without gradients the networks pool another way (see max_pool): the same floats as the
+// forward the learner differentiates, for both architectures, at both depths, with ties (empty
+// voxels give equal activations) and a batch of one.
+TEST(QAttentionNet, InferenceForwardEqualsTheTrainingForward) {
+  for (Architecture architecture : {Architecture::light, Architecture::arm}) {
+    seed_torch(6);
+    auto nets = make_coarse_to_fine_nets(config_of(architecture, architecture == Architecture::arm ? 8 : 16), 2);
+    for (auto& net : nets) {
+      SCOPED_TRACE(std::string(architecture_name(architecture)) + " depth " + std::to_string(net.config().depth));
+      for (int batch : {1, 3}) {
+        auto grid = torch::rand({batch, C, V, V, V});
+        grid.slice(2, 0, V / 2).zero_();  // half the grid empty
+        const auto proprio = torch::rand({batch, 4});
+        const QOutputs trained = net.module().forward(grid, proprio);
+        ASSERT_TRUE(trained.translation.requires_grad());
+        torch::NoGradGuard no_grad;
+        const QOutputs inferred = net.module().forward(grid, proprio);
+        EXPECT_TRUE(torch::equal(trained.translation, inferred.translation));
+        if (!net.config().is_last) continue;
+        EXPECT_TRUE(torch::equal(trained.rotation, inferred.rotation));
+        EXPECT_TRUE(torch::equal(trained.gripper, inferred.gripper));
+      }
+    }
+  }
+}
+
 // The leaves of a tree: predict_leaves gives every grid's translation Q at once and the head's
 // values later, for the rows asked for only; they are the floats predict gives those rows, in
 // every chunk of kPredictChunk and for a batch of one (run as two copies).
