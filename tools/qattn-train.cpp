@@ -102,7 +102,10 @@ static cli::Usage usage() {
       {"alpha", "A", "priority exponent", "0.7"},
       {"beta", "B", "importance-weight exponent: (N p)^-B over its batch maximum (published: 1/sqrt(p), B = 0.5)", "0.5"},
       {"capacity", "N", "replay capacity in transitions (demos always kept)", "100000"},
-      {"threads", "N", "LibTorch threads", "2"},
+      {"threads", "N",
+       "LibTorch threads; with more than 1 the program sets OMP_WAIT_POLICY=PASSIVE for itself unless it is set "
+       "(spinning OpenMP threads slow a program sharing the cores), at the price of a second start (~0.4 s)",
+       "2"},
   };
   u.add_options(voxels::hierarchy_options());
   u.add_options(qattention::branching_options());

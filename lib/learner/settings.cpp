@@ -58,7 +58,8 @@ double LearnerConfig::step_memory_bytes() const {
     target_grids += branches;
     branches *= std::min<double>(std::max(1, tree_target_k), cells);
   }
-  return batch * (per_sample + 2 * target_grids * grid_bytes) + 4e8;  // 2: online and target outputs; 0.4 GB base
+  // 2: online and target networks (their outputs, and the leaves' activations kept for the heads).
+  return batch * (per_sample + 2 * target_grids * grid_bytes) + 2 * nets::kDeferredHeadsBytes + 4e8;  // 0.4 GB base
 }
 
 void LearnerConfig::check_memory(double available_bytes) const {

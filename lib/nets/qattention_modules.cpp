@@ -50,21 +50,6 @@ class Layers {
   Sequential sequence_;
 };
 
-// 3x3x3 max pooling, stride 2, padding 1. Without gradients (acting, the targets' forwards) it
-// is elementwise maxima of strided views, one axis at a time: the same values as max_pool3d,
-// which also finds the argmax indices a backward pass needs and costs 4-5x as much (PyTorch
-// 1.13, one thread: 4.2 ms against 0.85 ms for 10 grids of 16 channels at 16^3; 19% of an
-// inference forward of `light` by PyTorch's profiler).
-torch::Tensor max_pool(const torch::Tensor& x) {
-  if (torch::GradMode::is_enabled()) return torch::max_pool3d(x, 3, 2, 1);
-  auto y = torch::constant_pad_nd(x, {1, 1, 1, 1, 1, 1}, -std::numeric_limits<double>::infinity());
-  for (int64_t dim = 2; dim < 5; ++dim) {
-    const int64_t out = (x.size(dim) - 1) / 2 + 1;
-    const auto window = [&](int64_t start) { return y.slice(dim, start, start + 2 * out - 1, 2); };
-    y = torch::maximum(torch::maximum(window(0), window(1)), window(2));
-  }
-  return y;
-}
 torch::Tensor upsample(const torch::Tensor& x) {
   return F::interpolate(x, F::InterpolateFuncOptions()
                                .scale_factor(std::vector<double>{2, 2, 2})
@@ -303,6 +288,16 @@ torch::Tensor channels_first(const torch::Tensor& grids) {
   return grids.permute({0, 4, 1, 2, 3}).contiguous();
 }
 
+torch::Tensor max_pool(const torch::Tensor& x) {
+  if (torch::GradMode::is_enabled()) return torch::max_pool3d(x, 3, 2, 1);
+  auto y = torch::constant_pad_nd(x, {1, 1, 1, 1, 1, 1}, -std::numeric_limits<double>::infinity());
+  for (int64_t dim = 2; dim < 5; ++dim) {
+    const int64_t out = (x.size(dim) - 1) / 2 + 1;
+    const auto window = [&](int64_t start) { return y.slice(dim, start, start + 2 * out - 1, 2); };
+    y = torch::maximum(torch::maximum(window(0), window(1)), window(2));
+  }
+  return y;
+}
 std::vector<torch::Tensor> parameters_of(std::vector<QAttentionNet>& nets) {
   std::vector<torch::Tensor> all;
   for (auto& net : nets) {

@@ -58,19 +58,21 @@ void append(std::vector<float>& to, const torch::Tensor& t) {
 // from the trunks of predict_leaves's chunks.
 void heads_of_rows(QAttentionModule& module, const std::vector<Trunk>& chunks, int batch, const std::vector<int>& rows,
                    QValues& into) {
+  for (int row : rows)
+    if (row < 0 || row >= batch)
+      throw Error("network heads asked for row " + std::to_string(row) + " of " + std::to_string(batch));
   constexpr int kRotations = kRotationAxes * kRotationBins;
   into.rotation.assign(static_cast<std::size_t>(batch) * kRotations, 0.0f);
   into.gripper.assign(static_cast<std::size_t>(batch) * kGripperActions, 0.0f);
   torch::NoGradGuard no_grad;
   for (std::size_t c = 0; c < chunks.size(); ++c) {
     const int first = static_cast<int>(c) * kPredictChunk;
+    std::vector<int> wanted;  // rows of this chunk
+    for (int row : rows)
+      if (row >= first && row < first + kPredictChunk) wanted.push_back(row);
+    if (wanted.empty()) continue;
     std::vector<int64_t> local;
-    std::vector<int> wanted;
-    for (int row : rows) {
-      if (row < 0 || row >= batch) throw Error("network heads asked for row " + std::to_string(row) + " of " + std::to_string(batch));
-      if (row >= first && row < first + kPredictChunk) local.push_back(row - first), wanted.push_back(row);
-    }
-    if (local.empty()) continue;
+    for (int row : wanted) local.push_back(row - first);
     const auto index = torch::tensor(local, torch::kLong);
     std::vector<torch::Tensor> levels;
     for (const auto& level : chunks[c].levels) levels.push_back(level.index_select(0, index));
@@ -85,17 +87,24 @@ void heads_of_rows(QAttentionModule& module, const std::vector<Trunk>& chunks, i
   }
 }
 
+int64_t level_bytes(const Trunk& trunk) {
+  int64_t bytes = 0;
+  for (const auto& level : trunk.levels) bytes += level.numel() * static_cast<int64_t>(sizeof(float));
+  return bytes;
+}
+
 }  // namespace
 
 QValues QAttentionNet::predict(const float* grids, const float* proprio, int batch) const {
-  return predict_chunks(grids, proprio, batch, true);
+  return predict_chunks(grids, proprio, batch, Heads::now, 0);
 }
 
-QValues QAttentionNet::predict_leaves(const float* grids, const float* proprio, int batch) const {
-  return predict_chunks(grids, proprio, batch, !config_.is_last);
+QValues QAttentionNet::predict_leaves(const float* grids, const float* proprio, int batch, double keep_bytes) const {
+  return predict_chunks(grids, proprio, batch, Heads::later, keep_bytes);
 }
 
-QValues QAttentionNet::predict_chunks(const float* grids, const float* proprio, int batch, bool heads_now) const {
+QValues QAttentionNet::predict_chunks(const float* grids, const float* proprio, int batch, Heads heads,
+                                      double keep_bytes) const {
   const int64_t v = config_.voxels;
   const std::size_t grid_floats = static_cast<std::size_t>(v * v * v * config_.channels);
   torch::NoGradGuard no_grad;
@@ -114,7 +123,10 @@ QValues QAttentionNet::predict_chunks(const float* grids, const float* proprio, 
     Trunk trunk = module_->trunk(channels_first(grid), state);
     append(values.translation, trunk.translation);
     if (!config_.is_last) continue;
-    if (heads_now) {
+    // Kept activations are bounded: a larger batch (a deep tree's leaves) gets its heads now.
+    if (heads == Heads::later && first == 0 && static_cast<double>(level_bytes(trunk)) / n * batch > keep_bytes)
+      heads = Heads::now;
+    if (heads == Heads::now) {
       QOutputs out;
       module_->heads(trunk.levels, out);
       append(values.rotation, out.rotation);
@@ -124,7 +136,7 @@ QValues QAttentionNet::predict_chunks(const float* grids, const float* proprio, 
       kept->push_back(std::move(trunk));
     }
   }
-  if (config_.is_last && !heads_now)
+  if (config_.is_last && heads == Heads::later)
     values.heads_for = [module = module_, kept, batch](const std::vector<int>& rows, QValues& into) {
       heads_of_rows(*module, *kept, batch, rows, into);
     };

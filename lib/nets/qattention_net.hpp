@@ -59,6 +59,7 @@ struct QValues {
 class QAttentionModule;  // the torch module (nets/qattention_modules.hpp)
 
 constexpr int kPredictChunk = 32;
+constexpr double kDeferredHeadsBytes = 256.0 * (1 << 20);  // predict_leaves's kept activations, at most
 
 class QAttentionNet {
  public:
@@ -78,14 +79,18 @@ class QAttentionNet {
   // The same for the leaves of a tree, which need every grid's translation Q but the dense
   // head only for the few leaves chosen from them: the head (pooled features and three linear
   // layers, ~15% of a last-depth forward) waits for `heads_for`, holding the trunk's
-  // activations until the QValues are gone. Without a head (not is_last): predict.
-  QValues predict_leaves(const float* grids, const float* proprio, int batch) const;
+  // activations until the QValues are gone — up to kDeferredHeadsBytes of them (light at 16^3:
+  // 0.6 MB a grid, so 2 depths of K = 10 at batch 32 wait; beyond, heads come at once, as from
+  // predict). Without a head (not is_last): predict.
+  QValues predict_leaves(const float* grids, const float* proprio, int batch,
+                         double keep_bytes = kDeferredHeadsBytes) const;
 
   QAttentionModule& module() { return *module_; }
   const QAttentionModule& module() const { return *module_; }
 
  private:
-  QValues predict_chunks(const float* grids, const float* proprio, int batch, bool heads_now) const;
+  enum class Heads { now, later };
+  QValues predict_chunks(const float* grids, const float* proprio, int batch, Heads heads, double keep_bytes) const;
 
   NetConfig config_;
   std::shared_ptr<QAttentionModule> module_;

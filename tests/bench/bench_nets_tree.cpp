@@ -59,7 +59,7 @@ int main(int, char** argv) {
     const double greedy = time(batched, 1), five = time(batched, 5), tree = time(batched, 10),
                  loop = time(sequential, 10);
     std::printf("%s act (voxelize + forwards), 2 threads: K=1 %.1f ms; K=5 %.1f ms (%.2fx K=1); K=10 batched %.1f ms "
-                "(%.2fx K=1); K=10 one forward per branch %.1f ms (batched %.2fx faster)\n",
+                "(%.2fx K=1); K=10 one forward per branch, every head %.1f ms (batched %.2fx faster)\n",
                 nets::architecture_name(architecture), greedy * 1e3, five * 1e3, five / greedy, tree * 1e3,
                 tree / greedy, loop * 1e3, loop / tree);
   }

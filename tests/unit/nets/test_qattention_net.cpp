@@ -113,6 +113,24 @@ TEST(QAttentionNet, OutputShapesForBothArchitecturesAndDepths) {
   }
 }
 
+// The pooling of forwards without gradients against max_pool3d: grid sides the U-Net meets
+// (16, 8, 4) and odd or small ones, ties, and NaN (both give NaN where a window holds one).
+TEST(QAttentionNet, PoolingWithoutGradientsEqualsMaxPool3d) {
+  torch::manual_seed(3);
+  for (int64_t side : {16, 8, 4, 6, 5, 2, 1}) {
+    SCOPED_TRACE("side " + std::to_string(side));
+    auto x = torch::randn({2, 3, side, side + 1, side});
+    x.slice(2, 0, (side + 1) / 2).fill_(0.25);  // ties
+    x[1][2][0][0][0] = std::nanf("");
+    const auto expected = torch::max_pool3d(x, 3, 2, 1);
+    torch::NoGradGuard no_grad;
+    const auto pooled = max_pool(x);
+    ASSERT_EQ(pooled.sizes(), expected.sizes());
+    EXPECT_TRUE(torch::equal(pooled.isnan(), expected.isnan()));
+    EXPECT_TRUE(torch::equal(pooled.nan_to_num(), expected.nan_to_num()));
+  }
+}
+
 // Without gradients the networks pool another way (see max_pool): the same floats as the
 // forward the learner differentiates, for both architectures, at both depths, with ties (empty
 // voxels give equal activations) and a batch of one.
@@ -142,7 +160,7 @@ TEST(QAttentionNet, InferenceForwardEqualsTheTrainingForward) {
 // The leaves of a tree: predict_leaves gives every grid's translation Q at once and the head's
 // values later, for the rows asked for only; they are the floats predict gives those rows, in
 // every chunk of kPredictChunk and for a batch of one (run as two copies).
-TEST(QAttentionNet, HeadsOfChosenLeavesEqualTheWholeBatchs) {
+TEST(QAttentionNet, HeadsOfChosenLeavesEqualTheWholeBatches) {
   for (Architecture architecture : {Architecture::light, Architecture::arm}) {
     SCOPED_TRACE(architecture_name(architecture));
     seed_torch(4);
@@ -168,6 +186,12 @@ TEST(QAttentionNet, HeadsOfChosenLeavesEqualTheWholeBatchs) {
       }
       EXPECT_THROW(leaves.heads_for({batch}, leaves), Error);
     }
+    // Activations beyond the bound are not kept: the heads come at once, as from predict.
+    const auto three = torch::rand({3, V, V, V, C}), their_proprio = torch::rand({3, 4});
+    const float *g = three.data_ptr<float>(), *p = their_proprio.data_ptr<float>();
+    const QValues bounded = nets[1].predict_leaves(g, p, 3, 1e5);
+    EXPECT_FALSE(bounded.heads_for);
+    EXPECT_EQ(bounded.rotation, nets[1].predict(g, p, 3).rotation);
     // Without a head there is nothing to wait for.
     const auto grid = torch::rand({2, V, V, V, C}), proprio = torch::rand({2, 4});
     const QValues coarse = nets[0].predict_leaves(grid.data_ptr<float>(), proprio.data_ptr<float>(), 2);
