@@ -3,41 +3,53 @@
 
     results_table.py [--markdown | --finals | --k-ablation] RUN.csv...
 
-One row per label (method): the runs' final evaluations (the last eval_point of each run):
+One row per task and label (method): the runs' final evaluations (the last eval_point of each run):
 the environment and learner steps they had taken (means), their success's mean and sample
 standard deviation, each run's successes with its Wilson 95% interval,
 and the mean training wall-clock (train_s) where the CSVs have it. --finals prints each run's
 final row instead (for a picture of final success per seed); --k-ablation the final rows of the
 runs that expand the same K when acting and in the target (labels qte-kK-tK), with K as a
-column (for a picture of success against K). Standard library only.
+column (for a picture of success against K). The task comes from the file's name as
+examples/Makefile writes it, TASK_LABEL-seedN.csv (empty for other names, such as eval.csv);
+--finals adds `series`, "TASK LABEL", for a picture of several tasks. Standard library only.
 """
 import argparse
 import csv
+import os
 import re
 import statistics
 import sys
 from collections import defaultdict
 
 
+def task_of(path, row):
+    """TASK of TASK_LABEL-seedN.csv (examples/Makefile's results), else ''."""
+    suffix = f"_{row['label']}-seed{row['seed']}.csv"
+    name = os.path.basename(path)
+    return name[:-len(suffix)] if name.endswith(suffix) else ""
+
+
 def final_rows(paths):
-    runs = defaultdict(list)  # label -> final row of each run, in the order given
+    runs = defaultdict(list)  # (task, label) -> final row of each run, in the order given
     for path in paths:
         with open(path, newline="") as f:
             rows = list(csv.DictReader(f))
         if not rows:
             sys.exit(f"{path}: no evaluation rows (expected learn.sh's eval.csv)")
         last = max(rows, key=lambda r: float(r["eval_point"]))
-        runs[last["label"]].append(last)
+        task = task_of(path, last)
+        runs[(task, last["label"])].append({"task": task, **last})
     return runs
 
 
-def summary(label, rows):
+def summary(task, label, rows):
     rates = [float(r["success_rate"]) for r in rows]
     times = [float(r["train_s"]) for r in rows if r.get("train_s")]
     per_run = " ".join(
         f"s{r['seed']}:{r['successes']}/{r['episodes']} [{float(r['ci95_low']):.2f},{float(r['ci95_high']):.2f}]"
         for r in sorted(rows, key=lambda r: int(r["seed"])))
     return {
+        "task": task,
         "label": label,
         "runs": len(rows),
         "env_steps": f"{statistics.mean(float(r['env_steps']) for r in rows):.0f}",
@@ -58,10 +70,11 @@ def main():
     args = parser.parse_args()
     runs = final_rows(args.runs)
     if args.finals or args.k_ablation:
-        rows = [row for label in sorted(runs) for row in sorted(runs[label], key=lambda r: int(r["seed"]))]
+        rows = [{"series": " ".join(filter(None, key)), **row}
+                for key in sorted(runs) for row in sorted(runs[key], key=lambda r: int(r["seed"]))]
         if args.k_ablation:
             same_k = [(re.fullmatch(r"qte-k(\d+)-t\1", row["label"]), row) for row in rows]
-            rows = [{"k": m.group(1), **row} for m, row in same_k if m]
+            rows = [{"k": m.group(1), **{c: v for c, v in row.items() if c != "series"}} for m, row in same_k if m]
             rows.sort(key=lambda r: (int(r["k"]), int(r["seed"])))
             if not rows:
                 return
@@ -69,7 +82,7 @@ def main():
         writer.writeheader()
         writer.writerows(rows)
         return
-    table = [summary(label, rows) for label, rows in sorted(runs.items())]
+    table = [summary(task, label, rows) for (task, label), rows in sorted(runs.items())]
     columns = list(table[0].keys())
     if args.markdown:
         print("| " + " | ".join(columns) + " |")

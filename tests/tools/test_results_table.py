@@ -1,0 +1,92 @@
+#!/usr/bin/env python3
+"""examples/results_table.py, the tables of `make -C examples paper-report`: runs of two tasks
+with the same method labels stay apart (the task from examples/Makefile's file names), each
+run counts by its last evaluation, and the means, standard deviations, Wilson intervals,
+per-seed finals and the K ablation are those of the rows written here."""
+import csv
+import io
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+
+SOURCE = os.environ.get("QTE_SOURCE") or os.path.join(os.path.dirname(__file__), "..", "..")
+SCRIPT = os.path.join(SOURCE, "examples", "results_table.py")
+COLUMNS = ["label", "seed", "env_steps", "train_step", "eval_point", "train_s", "cpu_s", "episodes", "successes",
+           "success_rate", "ci95_low", "ci95_high", "mean_steps", "mean_return"]
+
+
+def write_run(directory, name, label, seed, finals):
+    """An eval.csv of one run: an evaluation after pretraining, then `finals` = (successes, eval_point)."""
+    path = os.path.join(directory, name)
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(COLUMNS)
+        for successes, point in [(5, 0)] + finals:
+            w.writerow([label, seed, point, 100 + point // 10, point, 60 * (seed + 1), 100, 50, successes,
+                        successes / 50, 0.1, 0.9, 4, successes])
+    return path
+
+
+def run(*args, check=True):
+    return subprocess.run([sys.executable, SCRIPT, *args], capture_output=True, text=True, check=check)
+
+
+def rows_of(text):
+    return list(csv.DictReader(io.StringIO(text)))
+
+
+def main():
+    with tempfile.TemporaryDirectory() as d:
+        paths = [
+            write_run(d, "lift_numbered_block_c2farm-k1-t0-seed0.csv", "c2farm-k1-t0", 0, [(13, 400)]),
+            write_run(d, "lift_numbered_block_c2farm-k1-t0-seed1.csv", "c2farm-k1-t0", 1, [(20, 200), (10, 400)]),
+            write_run(d, "lift_numbered_block_qte-k10-t10-seed0.csv", "qte-k10-t10", 0, [(19, 400)]),
+            write_run(d, "pick_and_lift_small_qte-k10-t10-seed0.csv", "qte-k10-t10", 0, [(40, 5000)]),
+            write_run(d, "reach_prism_qte-k2-t2-seed0.csv", "qte-k2-t2", 0, [(36, 2000)]),
+        ]
+        table = rows_of(run(*paths).stdout)
+        keys = [(r["task"], r["label"]) for r in table]
+        assert keys == [("lift_numbered_block", "c2farm-k1-t0"), ("lift_numbered_block", "qte-k10-t10"),
+                        ("pick_and_lift_small", "qte-k10-t10"), ("reach_prism", "qte-k2-t2")], keys
+        c2farm = table[0]
+        assert c2farm["runs"] == "2"
+        # The last evaluation of each run counts (seed 1's 10/50 at 400, not its 20/50 at 200).
+        assert c2farm["mean_success"] == f"{statistics.mean([13 / 50, 10 / 50]):.3f}", c2farm
+        assert c2farm["std_success"] == f"{statistics.stdev([13 / 50, 10 / 50]):.3f}", c2farm
+        assert c2farm["per_run"] == "s0:13/50 [0.10,0.90] s1:10/50 [0.10,0.90]", c2farm["per_run"]
+        assert c2farm["mean_train_min"] == f"{statistics.mean([60, 120]) / 60:.1f}", c2farm
+        assert table[2]["mean_success"] == "0.800" and table[2]["std_success"] == "", table[2]
+
+        markdown = run("--markdown", *paths).stdout.splitlines()
+        assert markdown[0].startswith("| task | label | runs |"), markdown[0]
+        assert len(markdown) == 2 + len(table), markdown
+
+        finals = rows_of(run("--finals", *paths).stdout)
+        assert [(r["series"], r["seed"], r["successes"]) for r in finals] == [
+            ("lift_numbered_block c2farm-k1-t0", "0", "13"), ("lift_numbered_block c2farm-k1-t0", "1", "10"),
+            ("lift_numbered_block qte-k10-t10", "0", "19"), ("pick_and_lift_small qte-k10-t10", "0", "40"),
+            ("reach_prism qte-k2-t2", "0", "36")], finals
+
+        ablation = rows_of(run("--k-ablation", *paths).stdout)
+        assert [(r["k"], r["label"]) for r in ablation] == [("2", "qte-k2-t2"), ("10", "qte-k10-t10"),
+                                                            ("10", "qte-k10-t10")], ablation
+        assert "series" not in ablation[0]
+
+        # A run's own eval.csv (no task in its name) is grouped by label alone.
+        own = write_run(d, "eval.csv", "qte-k10-t10", 3, [(30, 400)])
+        alone = rows_of(run(own).stdout)
+        assert [(r["task"], r["label"], r["runs"]) for r in alone] == [("", "qte-k10-t10", "1")], alone
+        assert rows_of(run("--finals", own).stdout)[0]["series"] == "qte-k10-t10"
+
+        empty = os.path.join(d, "empty.csv")
+        with open(empty, "w") as f:
+            f.write(",".join(COLUMNS) + "\n")
+        refused = run(empty, check=False)
+        assert refused.returncode != 0 and "empty.csv: no evaluation rows" in refused.stderr, refused
+    print("results_table: tasks apart, last evaluations, means, finals and K ablation as written")
+
+
+if __name__ == "__main__":
+    main()
