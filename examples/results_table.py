@@ -2,6 +2,7 @@
 """Final success per method over seeds, from learn.sh's eval.csv files (one per run).
 
     results_table.py [--markdown | --finals | --k-ablation] RUN.csv...
+    results_table.py --failures FAILURES.csv...
 
 One row per task and label (method): the runs' final evaluations (the last eval_point of each run):
 the environment and learner steps they had taken (means), their success's mean and sample
@@ -11,7 +12,9 @@ final row instead (for a picture of final success per seed); --k-ablation the fi
 runs that expand the same K when acting and in the target (labels qte-kK-tK), with K as a
 column (for a picture of success against K). The task comes from the file's name as
 examples/Makefile writes it, TASK_LABEL-seedN.csv (empty for other names, such as eval.csv);
---finals adds `series`, "TASK LABEL", for a picture of several tasks. Standard library only.
+--finals adds `series`, "TASK LABEL", for a picture of several tasks. --failures joins the
+runs' failure_reasons CSVs (results/<takeaway>/failures/, named the same way) into one with the
+task as first column. Standard library only.
 """
 import argparse
 import csv
@@ -27,6 +30,18 @@ def task_of(path, row):
     suffix = f"_{row['label']}-seed{row['seed']}.csv"
     name = os.path.basename(path)
     return name[:-len(suffix)] if name.endswith(suffix) else ""
+
+
+def failures(paths):
+    """Every run's failure_reasons rows under one header, each with its run's task."""
+    writer = None
+    for path in paths:
+        with open(path, newline="") as f:
+            for row in csv.DictReader(f):
+                if writer is None:
+                    writer = csv.DictWriter(sys.stdout, fieldnames=["task", *row], lineterminator="\n")
+                    writer.writeheader()
+                writer.writerow({"task": task_of(path, row), **row})
 
 
 def final_rows(paths):
@@ -66,8 +81,12 @@ def main():
     parser.add_argument("--markdown", action="store_true", help="a Markdown table instead of CSV")
     parser.add_argument("--finals", action="store_true", help="each run's final row, as CSV")
     parser.add_argument("--k-ablation", action="store_true", help="final rows of the qte-kK-tK runs with K, as CSV")
+    parser.add_argument("--failures", action="store_true", help="join failure_reasons CSVs, with the task")
     parser.add_argument("runs", nargs="+")
     args = parser.parse_args()
+    if args.failures:
+        failures(args.runs)
+        return
     runs = final_rows(args.runs)
     if args.finals or args.k_ablation:
         rows = [{"series": " ".join(filter(None, key)), **row}

@@ -93,24 +93,34 @@ int64_t level_bytes(const Trunk& trunk) {
   return bytes;
 }
 
+char** program_arguments = nullptr;  // kept by prepare_process_for_networks for the re-execution
+
+// Executes this program again with the same arguments (by its own path, so that it keeps its
+// name for ps, pgrep and perf: "qte-select", not "exe"); returns only if that fails.
+void execute_again() {
+  char self[4096];
+  const ssize_t length = ::readlink("/proc/self/exe", self, sizeof self - 1);
+  if (length > 0) {
+    self[length] = '\0';
+    ::execv(self, program_arguments);
+  }
+  ::execv("/proc/self/exe", program_arguments);
+}
+
 }  // namespace
 
 QValues QAttentionNet::predict(const float* grids, const float* proprio, int batch) const {
-  return predict_chunks(grids, proprio, batch, Heads::now, 0);
+  return predict_leaves(grids, proprio, batch, 0);  // nothing kept: every head at once
 }
 
 QValues QAttentionNet::predict_leaves(const float* grids, const float* proprio, int batch, double keep_bytes) const {
-  return predict_chunks(grids, proprio, batch, Heads::later, keep_bytes);
-}
-
-QValues QAttentionNet::predict_chunks(const float* grids, const float* proprio, int batch, Heads heads,
-                                      double keep_bytes) const {
   const int64_t v = config_.voxels;
   const std::size_t grid_floats = static_cast<std::size_t>(v * v * v * config_.channels);
   torch::NoGradGuard no_grad;
   QValues values;
   values.batch = batch;
   auto kept = std::make_shared<std::vector<Trunk>>();
+  bool heads_later = false;
   // Large batches (tree-expanded targets: batch x K grids) go through in chunks: LibTorch's
   // 3D convolutions cost more per sample beyond a few dozen samples (measured with light:
   // 2.3 ms per sample at 32-128, 4.1 ms at 352).
@@ -124,9 +134,8 @@ QValues QAttentionNet::predict_chunks(const float* grids, const float* proprio, 
     append(values.translation, trunk.translation);
     if (!config_.is_last) continue;
     // Kept activations are bounded: a larger batch (a deep tree's leaves) gets its heads now.
-    if (heads == Heads::later && first == 0 && static_cast<double>(level_bytes(trunk)) / n * batch > keep_bytes)
-      heads = Heads::now;
-    if (heads == Heads::now) {
+    if (first == 0) heads_later = static_cast<double>(level_bytes(trunk)) / n * batch <= keep_bytes;
+    if (!heads_later) {
       QOutputs out;
       module_->heads(trunk.levels, out);
       append(values.rotation, out.rotation);
@@ -136,7 +145,7 @@ QValues QAttentionNet::predict_chunks(const float* grids, const float* proprio, 
       kept->push_back(std::move(trunk));
     }
   }
-  if (config_.is_last && heads == Heads::later)
+  if (heads_later)
     values.heads_for = [module = module_, kept, batch](const std::vector<int>& rows, QValues& into) {
       heads_of_rows(*module, *kept, batch, rows, into);
     };
@@ -156,21 +165,6 @@ std::vector<QAttentionNet> make_coarse_to_fine_nets(NetConfig config, int depths
 
 void seed_torch(uint64_t seed) { torch::manual_seed(seed); }
 
-namespace {
-char** program_arguments = nullptr;  // kept by prepare_process_for_networks for the re-execution
-
-// Executes this program again with the same arguments (by its own path, so that it keeps its
-// name for ps, pgrep and perf: "qte-select", not "exe"); returns only if that fails.
-void execute_again() {
-  char self[4096];
-  const ssize_t length = ::readlink("/proc/self/exe", self, sizeof self - 1);
-  if (length > 0) {
-    self[length] = '\0';
-    ::execv(self, program_arguments);
-  }
-  ::execv("/proc/self/exe", program_arguments);
-}
-}  // namespace
 
 void prepare_process_for_networks(char** argv) {
   program_arguments = argv;

@@ -81,7 +81,7 @@ class QAttentionNet {
   // layers, ~15% of a last-depth forward) waits for `heads_for`, holding the trunk's
   // activations until the QValues are gone — up to kDeferredHeadsBytes of them (light at 16^3:
   // 0.6 MB a grid, so 2 depths of K = 10 at batch 32 wait; beyond, heads come at once, as from
-  // predict). Without a head (not is_last): predict.
+  // predict, which is keep_bytes 0). Without a head (not is_last): predict.
   QValues predict_leaves(const float* grids, const float* proprio, int batch,
                          double keep_bytes = kDeferredHeadsBytes) const;
 
@@ -89,8 +89,6 @@ class QAttentionNet {
   const QAttentionModule& module() const { return *module_; }
 
  private:
-  enum class Heads { now, later };
-  QValues predict_chunks(const float* grids, const float* proprio, int batch, Heads heads, double keep_bytes) const;
 
   NetConfig config_;
   std::shared_ptr<QAttentionModule> module_;

@@ -80,6 +80,19 @@ def main():
         assert [(r["task"], r["label"], r["runs"]) for r in alone] == [("", "qte-k10-t10", "1")], alone
         assert rows_of(run("--finals", own).stdout)[0]["series"] == "qte-k10-t10"
 
+        # failure_reasons CSVs joined, each row with its run's task.
+        failed = []
+        for name, label, seed in [("reach_prism_qte-k2-t2-seed1.csv", "qte-k2-t2", 1),
+                                  ("lift_numbered_block_c2farm-k1-t0-seed0.csv", "c2farm-k1-t0", 0)]:
+            path = os.path.join(d, "failures_" + name)
+            with open(path, "w") as f:
+                f.write(f"label,seed,episodes,success\n{label},{seed},50,{20 + seed}\n")
+            failed.append(path)
+        # The task is what precedes _LABEL-seedN.csv in the name (here with a "failures_" prefix).
+        joined = rows_of(run("--failures", *failed).stdout)
+        assert [(r["task"], r["label"], r["success"]) for r in joined] == [
+            ("failures_reach_prism", "qte-k2-t2", "21"), ("failures_lift_numbered_block", "c2farm-k1-t0", "20")], joined
+
         empty = os.path.join(d, "empty.csv")
         with open(empty, "w") as f:
             f.write(",".join(COLUMNS) + "\n")
