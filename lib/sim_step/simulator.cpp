@@ -131,7 +131,12 @@ void Simulator::reset(const stream::Record& record, const stream::Emit& emit) {
   episode_seed_ = record.has("seed") ? record.scalar<int64_t>("seed") : 0;
   world_ = std::make_unique<world::World>(robot_);
   std::mt19937_64 rng(static_cast<uint64_t>(episode_seed_));
-  task_->build(*world_, variation_, rng);
+  try {
+    task_->build(*world_, variation_, rng);
+  } catch (const Error& e) {  // name the scene, so that it can be built again by itself
+    throw Error(task_name_ + " variation " + std::to_string(variation_) + " scene seed " +
+                std::to_string(episode_seed_) + ": " + e.what());
+  }
   world_->settle(0.25);  // objects come to rest before the first image
   step_ = frame_ = 0;
   time_s_ = 0;

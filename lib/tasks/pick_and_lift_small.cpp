@@ -5,6 +5,7 @@
 // are one voxel each and alike; only the finer depths tell them apart. The other sizes are
 // ours (RLBench's meshes are not public here): each shape fits the cube's bounding square
 // or a little more, so none is told apart by size at depth 0.
+#include "common/error.hpp"
 #include "tasks/blocks.hpp"
 #include "tasks/shapes.hpp"
 
@@ -36,10 +37,20 @@ class PickAndLiftSmall : public Task {
   void build(world::World& world, int variation, std::mt19937_64& rng) override {
     target_ = kShapes[variation];
     // The shapes 10 cm apart; the zone (above the table) 15 cm from each in plan view, so the
-    // arm over a shape never reaches into it (the planner sees it as an obstacle).
-    const auto positions = sample_separated(rng, 5, {kRegionMinX, kRegionMinY, 0}, {kRegionMaxX, kRegionMaxY, 0}, 0.1);
-    const Eigen::Vector3d zone_xy = sample_away_from(rng, positions, {kRegionMinX, kRegionMinY, 0},
-                                                     {kRegionMaxX, kRegionMaxY, 0}, 0.15);
+    // arm over a shape never reaches into it (the planner sees it as an obstacle). About one
+    // layout in 800 leaves no room for the zone: it is drawn again from the same stream, so
+    // every scene that had room is the scene it always was.
+    std::vector<Eigen::Vector3d> positions;
+    Eigen::Vector3d zone_xy;
+    for (int layout = 0;; ++layout) {
+      positions = sample_separated(rng, 5, {kRegionMinX, kRegionMinY, 0}, {kRegionMaxX, kRegionMaxY, 0}, 0.1);
+      try {
+        zone_xy = sample_away_from(rng, positions, {kRegionMinX, kRegionMinY, 0}, {kRegionMaxX, kRegionMaxY, 0}, 0.15);
+        break;
+      } catch (const Error&) {
+        if (layout == 99) throw;
+      }
+    }
     std::uniform_real_distribution<double> yaw(-M_PI, M_PI);
     const Eigen::Vector3f colour(0.2f, 0.45f, 0.95f);
     for (int i = 0; i < 5; ++i) {
