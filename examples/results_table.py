@@ -2,6 +2,8 @@
 """Final success per method over seeds, from learn.sh's eval.csv files (one per run).
 
     results_table.py [--markdown | --finals | --k-ablation] RUN.csv...
+    results_table.py --tasks RUN.csv...
+    results_table.py --curves --task TASK RUN.csv...
     results_table.py --failures FAILURES.csv...
 
 One row per task and label (method): the runs' final evaluations (the last eval_point of each run):
@@ -12,7 +14,9 @@ final row instead (for a picture of final success per seed); --k-ablation the fi
 runs that expand the same K when acting and in the target (labels qte-kK-tK), with K as a
 column (for a picture of success against K). The task comes from the file's name as
 examples/Makefile writes it, TASK_LABEL-seedN.csv (empty for other names, such as eval.csv);
---finals adds `series`, "TASK LABEL", for a picture of several tasks. --failures joins the
+--finals adds `series`, "TASK LABEL", for a picture of several tasks. --tasks lists the runs'
+tasks; --curves every evaluation of TASK's runs, with the task, for a picture of learning curves
+(mean +- std over seeds at each eval_point). --failures joins the
 runs' failure_reasons CSVs (results/<takeaway>/failures/, named the same way) into one with the
 task as first column. Standard library only.
 """
@@ -44,15 +48,31 @@ def failures(paths):
                 writer.writerow({"task": task_of(path, row), **row})
 
 
-def final_rows(paths):
-    runs = defaultdict(list)  # (task, label) -> final row of each run, in the order given
+def evaluations(paths):
+    """(task, rows) of each run, its rows in the file's order."""
     for path in paths:
         with open(path, newline="") as f:
             rows = list(csv.DictReader(f))
         if not rows:
             sys.exit(f"{path}: no evaluation rows (expected learn.sh's eval.csv)")
+        yield task_of(path, rows[0]), rows
+
+
+def curves(paths, task):
+    """Every evaluation of the runs of `task`, by label, seed and eval_point."""
+    rows = [{"task": t, **row} for t, run_rows in evaluations(paths) if t == task for row in run_rows]
+    rows.sort(key=lambda r: (r["label"], int(r["seed"]), float(r["eval_point"])))
+    if not rows:
+        sys.exit(f"no runs of task '{task}' among the {len(paths)} given")
+    writer = csv.DictWriter(sys.stdout, fieldnames=list(rows[0].keys()), lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+
+
+def final_rows(paths):
+    runs = defaultdict(list)  # (task, label) -> final row of each run, in the order given
+    for task, rows in evaluations(paths):
         last = max(rows, key=lambda r: float(r["eval_point"]))
-        task = task_of(path, last)
         runs[(task, last["label"])].append({"task": task, **last})
     return runs
 
@@ -82,10 +102,21 @@ def main():
     parser.add_argument("--finals", action="store_true", help="each run's final row, as CSV")
     parser.add_argument("--k-ablation", action="store_true", help="final rows of the qte-kK-tK runs with K, as CSV")
     parser.add_argument("--failures", action="store_true", help="join failure_reasons CSVs, with the task")
+    parser.add_argument("--tasks", action="store_true", help="the runs' tasks, one a line")
+    parser.add_argument("--curves", action="store_true", help="every evaluation of --task's runs, as CSV")
+    parser.add_argument("--task", help="the task of --curves")
     parser.add_argument("runs", nargs="+")
     args = parser.parse_args()
     if args.failures:
         failures(args.runs)
+        return
+    if args.tasks:
+        print("\n".join(sorted({task for task, _ in evaluations(args.runs)})))
+        return
+    if args.curves:
+        if not args.task:
+            parser.error("--curves needs --task")
+        curves(args.runs, args.task)
         return
     runs = final_rows(args.runs)
     if args.finals or args.k_ablation:

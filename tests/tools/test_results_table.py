@@ -2,7 +2,7 @@
 """examples/results_table.py, the tables of `make -C examples paper-report`: runs of two tasks
 with the same method labels stay apart (the task from examples/Makefile's file names), each
 run counts by its last evaluation, and the means, standard deviations, Wilson intervals,
-per-seed finals and the K ablation are those of the rows written here."""
+per-seed finals, learning curves and the K ablation are those of the rows written here."""
 import csv
 import io
 import os
@@ -74,6 +74,23 @@ def main():
                                                             ("10", "qte-k10-t10")], ablation
         assert "series" not in ablation[0]
 
+        # Learning curves: every evaluation of one task's runs, pick_and_lift's apart from
+        # pick_and_lift_small's though one name begins the other.
+        lift = write_run(d, "pick_and_lift_qte-k10-t10-seed0.csv", "qte-k10-t10", 0, [(30, 1000), (35, 5000)])
+        with_lift = paths + [lift]
+        assert run("--tasks", *with_lift).stdout.split() == [
+            "lift_numbered_block", "pick_and_lift", "pick_and_lift_small", "reach_prism"]
+        curve = rows_of(run("--curves", "--task", "lift_numbered_block", *with_lift).stdout)
+        assert [(r["task"], r["label"], r["seed"], r["eval_point"], r["successes"]) for r in curve] == [
+            ("lift_numbered_block", "c2farm-k1-t0", "0", "0", "5"), ("lift_numbered_block", "c2farm-k1-t0", "0", "400", "13"),
+            ("lift_numbered_block", "c2farm-k1-t0", "1", "0", "5"), ("lift_numbered_block", "c2farm-k1-t0", "1", "200", "20"),
+            ("lift_numbered_block", "c2farm-k1-t0", "1", "400", "10"), ("lift_numbered_block", "qte-k10-t10", "0", "0", "5"),
+            ("lift_numbered_block", "qte-k10-t10", "0", "400", "19")], curve
+        picked = rows_of(run("--curves", "--task", "pick_and_lift", *with_lift).stdout)
+        assert [(r["eval_point"], r["successes"]) for r in picked] == [("0", "5"), ("1000", "30"), ("5000", "35")], picked
+        unknown = run("--curves", "--task", "stack_blocks", *with_lift, check=False)
+        assert unknown.returncode != 0 and "no runs of task 'stack_blocks'" in unknown.stderr, unknown
+
         # A run's own eval.csv (no task in its name) is grouped by label alone.
         own = write_run(d, "eval.csv", "qte-k10-t10", 3, [(30, 400)])
         alone = rows_of(run(own).stdout)
@@ -98,7 +115,7 @@ def main():
             f.write(",".join(COLUMNS) + "\n")
         refused = run(empty, check=False)
         assert refused.returncode != 0 and "empty.csv: no evaluation rows" in refused.stderr, refused
-    print("results_table: tasks apart, last evaluations, means, finals and K ablation as written")
+    print("results_table: tasks apart, last evaluations, means, finals, curves and K ablation as written")
 
 
 if __name__ == "__main__":
