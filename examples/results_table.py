@@ -5,6 +5,7 @@
     results_table.py --tasks RUN.csv...
     results_table.py --curves --task TASK RUN.csv...
     results_table.py --failures FAILURES.csv...
+    results_table.py --lookalikes FAILURES.csv...
 
 One row per task and label (method): the runs' final evaluations (the last eval_point of each run):
 the environment and learner steps they had taken (means), their success's mean and sample
@@ -18,7 +19,9 @@ examples/Makefile writes it, TASK_LABEL-seedN.csv (empty for other names, such a
 tasks; --curves every evaluation of TASK's runs, with the task, for a picture of learning curves
 (mean +- std over seeds at each eval_point). --failures joins the
 runs' failure_reasons CSVs (results/<takeaway>/failures/, named the same way) into one with the
-task as first column. Standard library only.
+task as first column; --lookalikes sums them per task and label: of the episodes that went for an
+object (success, target or distractor), the share that went for the right one (success or
+target), to set beside the chance of picking among the task's lookalikes. Standard library only.
 """
 import argparse
 import csv
@@ -46,6 +49,27 @@ def failures(paths):
                     writer = csv.DictWriter(sys.stdout, fieldnames=["task", *row], lineterminator="\n")
                     writer.writeheader()
                 writer.writerow({"task": task_of(path, row), **row})
+
+
+def lookalikes(paths):
+    """Per task and label, the failure kinds summed over runs and the share of tries at an
+    object that went for the right one."""
+    sums = defaultdict(lambda: defaultdict(int))
+    for path in paths:
+        with open(path, newline="") as f:
+            for row in csv.DictReader(f):
+                total = sums[(task_of(path, row), row["label"])]
+                total["runs"] += 1
+                for kind in ("episodes", "success", "target", "distractor", "elsewhere"):
+                    total[kind] += int(row[kind])
+    writer = csv.writer(sys.stdout, lineterminator="\n")
+    writer.writerow(["task", "label", "runs", "episodes", "success", "target", "distractor", "elsewhere",
+                     "tries_at_an_object", "right_share"])
+    for (task, label), t in sorted(sums.items()):
+        tries = t["success"] + t["target"] + t["distractor"]
+        right = f"{(t['success'] + t['target']) / tries:.3f}" if tries else ""
+        writer.writerow([task, label, t["runs"], t["episodes"], t["success"], t["target"], t["distractor"],
+                         t["elsewhere"], tries, right])
 
 
 def evaluations(paths):
@@ -102,6 +126,8 @@ def main():
     parser.add_argument("--finals", action="store_true", help="each run's final row, as CSV")
     parser.add_argument("--k-ablation", action="store_true", help="final rows of the qte-kK-tK runs with K, as CSV")
     parser.add_argument("--failures", action="store_true", help="join failure_reasons CSVs, with the task")
+    parser.add_argument("--lookalikes", action="store_true",
+                        help="failure_reasons CSVs summed per task and label, with the right share of tries")
     parser.add_argument("--tasks", action="store_true", help="the runs' tasks, one a line")
     parser.add_argument("--curves", action="store_true", help="every evaluation of --task's runs, as CSV")
     parser.add_argument("--task", help="the task of --curves")
@@ -109,6 +135,9 @@ def main():
     args = parser.parse_args()
     if args.failures:
         failures(args.runs)
+        return
+    if args.lookalikes:
+        lookalikes(args.runs)
         return
     if args.tasks:
         print("\n".join(sorted({task for task, _ in evaluations(args.runs)})))

@@ -110,12 +110,29 @@ def main():
         assert [(r["task"], r["label"], r["success"]) for r in joined] == [
             ("failures_reach_prism", "qte-k2-t2", "21"), ("failures_lift_numbered_block", "c2farm-k1-t0", "20")], joined
 
+        # Summed per task and label: of the tries at an object (success, target, distractor),
+        # the share at the right one (success, target).
+        tried = []
+        for name, label, seed, kinds in [("lift_numbered_block_qte-k10-t10-seed0.csv", "qte-k10-t10", 0, (19, 0, 31, 0)),
+                                         ("lift_numbered_block_qte-k10-t10-seed1.csv", "qte-k10-t10", 1, (23, 2, 25, 0)),
+                                         ("reach_prism_qte-k1-t1-seed2.csv", "qte-k1-t1", 2, (0, 0, 0, 50))]:
+            path = os.path.join(d, "lookalike_" + name)
+            with open(path, "w") as f:
+                f.write("label,seed,episodes,success,target,distractor,elsewhere,failed_actions\n")
+                f.write(f"{label},{seed},50,{','.join(map(str, kinds))},0\n")
+            tried.append(path)
+        summed = rows_of(run("--lookalikes", *tried).stdout)
+        assert [(r["task"], r["label"], r["runs"], r["episodes"], r["tries_at_an_object"], r["right_share"])
+                for r in summed] == [
+            ("lookalike_lift_numbered_block", "qte-k10-t10", "2", "100", "100", f"{(19 + 23 + 2) / 100:.3f}"),
+            ("lookalike_reach_prism", "qte-k1-t1", "1", "50", "0", "")], summed
+
         empty = os.path.join(d, "empty.csv")
         with open(empty, "w") as f:
             f.write(",".join(COLUMNS) + "\n")
         refused = run(empty, check=False)
         assert refused.returncode != 0 and "empty.csv: no evaluation rows" in refused.stderr, refused
-    print("results_table: tasks apart, last evaluations, means, finals, curves and K ablation as written")
+    print("results_table: tasks apart, last evaluations, means, finals, curves, lookalikes and K ablation as written")
 
 
 if __name__ == "__main__":
