@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Can the networks tell a task's lookalikes apart at all? Trained on the demonstrations alone (a
+# run's, as learn.sh records them for SEED: no exploration, no RL budget) for far more learner
+# steps than a run takes, then greedy on the 50 held-out scenes acting with K = 1 and K = 10;
+# failure_reasons.sh says where each episode went. If even then the share of tries at an object
+# that go for the right one stays at chance, the finest depth has not learned what tells the
+# objects apart, and no tree expansion can use it.
+# Usage: demos_only.sh TASK OUT_DIR   (the built programs on PATH; settings from the
+#        environment: SEED 0, DEMOS 10, IMAGE 256x256, STEPS 2000, N_STEP 3, VARIATION 0,
+#        NET_OPTIONS e.g. "--depths 3 --offset 0.15,0.05"; make -C examples demos-only).
+# Writes OUT_DIR/failures-stepSTEPS-kK.csv; resumable (the learner resumes, finished CSVs stay).
+set -euo pipefail
+task=$1 out=$2
+: "${SEED:=0}" "${DEMOS:=10}" "${IMAGE:=256x256}" "${STEPS:=2000}" "${N_STEP:=3}" "${VARIATION:=0}" "${NET_OPTIONS:=}"
+here=$(cd "$(dirname "$0")" && pwd)
+mkdir -p "$out"
+if [ ! -f "$out/replay.rec" ]; then  # learn.sh's demonstrations for SEED, the same bytes
+  demo-record --task "$task" --episodes "$DEMOS" --seed "$SEED" --scenes demo --variation "$VARIATION" --image-size "$IMAGE" \
+    --compress --output "$out/demos.rec" 2> "$out/demos.log"
+  keyframe --seed "$SEED" $NET_OPTIONS --output "$out/replay.rec.tmp" "$out/demos.rec" 2>> "$out/demos.log"
+  mv "$out/replay.rec.tmp" "$out/replay.rec"
+fi
+qattn-train --resume --steps "$STEPS" --start-after 0 --checkpoint-every 250 --keep 20 --architecture light --batch 32 \
+  --n-step "$N_STEP" $NET_OPTIONS --seed "$SEED" --threads 1 --checkpoint-dir "$out/ckpt" --metrics "$out/train.csv" \
+  "$out/replay.rec" 2>> "$out/train.log"
+for k in 1 10; do
+  csv=$out/failures-step$STEPS-k$k.csv
+  [ -f "$csv" ] && continue
+  VARIATION=$VARIATION bash "$here/failure_reasons.sh" "$task" "$out/ckpt/step-$(printf '%08d' "$STEPS").rec" "$k" "$IMAGE" 50 \
+    "demonstrations only, $STEPS steps${NET_OPTIONS:+ ($NET_OPTIONS)}, acting K=$k" "$SEED" > "$csv.tmp"
+  mv "$csv.tmp" "$csv"
+done
+cat "$out"/failures-step"$STEPS"-k*.csv | awk 'NR == 1 || !/^label/'
