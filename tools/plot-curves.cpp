@@ -38,6 +38,11 @@ static cli::Usage usage() {
       "axes span the data and bands with a small margin; --y-range fixes the y axis (0,1 for "
       "success rates; what lies outside is clipped). The same input and options give the same "
       "bytes. The PNG is written under a temporary name and renamed into place when complete.",
+      "With --panel COLUMN the picture is small multiples: one plot per distinct value of "
+      "COLUMN (a task, say), titled with it, in the order the values first appear, "
+      "--panel-columns to a row under the --title. --size is then the size of one panel. The "
+      "panels share the vertical axis and each spans its own horizontal extent (tasks train "
+      "for different numbers of steps); a group has the same colour in every panel.",
       "A table without one of the columns asked for, a cell of --x, --y (or of the interval "
       "columns for --band ci) that is not a finite number, a row with the wrong number of "
       "cells, or no rows at all stop the program with one line naming the file, line and "
@@ -54,7 +59,9 @@ static cli::Usage usage() {
       {"x-label", "L", "label of the horizontal axis (default: the --x column)", ""},
       {"y-label", "L", "label of the vertical axis (default: the --y column)", ""},
       {"y-range", "LO,HI", "fix the vertical axis to LO..HI", ""},
-      {"size", "WxH", "picture size in pixels", "800x500"},
+      {"size", "WxH", "picture size in pixels (of each panel with --panel)", "800x500"},
+      {"panel", "COLUMN", "one plot per distinct value of COLUMN (e.g. task), side by side", ""},
+      {"panel-columns", "N", "panels to a row with --panel", "4"},
   };
   u.examples = {
       {"plot-curves --x step --y success_rate --group label --band ci --y-range 0,1 "
@@ -64,6 +71,10 @@ static cli::Usage usage() {
       {"plot-curves --x step --y mean_steps --group label --band none --output steps.png curves.csv",
        "the mean episode length of the same runs, means only"},
   };
+  u.examples.push_back(
+      {"plot-curves --x env_steps --y success_rate --group label --panel task --panel-columns 4 --size 560x360 "
+       "--y-range 0,1 --title 'Task Set 1' --output tasks.png curves.csv",
+       "one panel per task, both methods in each, as the paper's figures of learning curves"});
   u.see_also = {"episode-stats(1)"};
   return u;
 }
@@ -85,8 +96,16 @@ static std::pair<int, int> parse_size(const std::string& text) {
   return {w, h};
 }
 
+static int parse_columns(const std::string& text) {
+  int n = 0;
+  char rest = 0;
+  if (std::sscanf(text.c_str(), "%d%c", &n, &rest) != 1 || n < 1 || n > 100)
+    throw UsageError("--panel-columns: expected a number from 1 to 100, got '" + text + "'");
+  return n;
+}
+
 static void run(const cli::Arguments& args) {
-  report::CurveColumns columns{args.text("x"), args.text("y"), args.text("group")};
+  report::CurveColumns columns{args.text("x"), args.text("y"), args.text("group"), args.text("panel")};
   const std::string output = args.text("output");
   const report::Band band =
       std::array{report::Band::std_dev, report::Band::ci, report::Band::none}[args.choice("band", {"std", "ci", "none"})];
@@ -101,7 +120,10 @@ static void run(const cli::Arguments& args) {
 
   report::CurveBuilder curves(columns, band);
   for (const std::string& file : args.positional()) curves.add(report::read_csv(file));
-  report::save_curve_plot(output, curves.curves(), plot);
+  if (columns.panel.empty())
+    report::save_curve_plot(output, curves.curves(), plot);
+  else
+    report::save_panel_plot(output, curves.panels(), plot, parse_columns(args.text("panel-columns")));
 }
 
 int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }

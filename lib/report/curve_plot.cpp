@@ -82,6 +82,14 @@ struct Style {
   int thickness, line_thickness, marker_radius;
 };
 
+// Text and lines in proportion to the picture, as at 800x500.
+Style style_for(cv::Size size) {
+  const double scale = std::clamp(std::min(size.width / 800.0, size.height / 500.0), 0.6, 3.0);
+  return Style{scale, 0.42 * scale, 0.5 * scale, 0.62 * scale, std::max(1, static_cast<int>(std::lround(scale))),
+               std::max(1, static_cast<int>(std::lround(2 * scale))),
+               std::max(2, static_cast<int>(std::lround(3 * scale)))};
+}
+
 cv::Size text_size(const std::string& text, double scale, int thickness) {
   int baseline = 0;
   cv::Size s = cv::getTextSize(text, kFont, scale, thickness, &baseline);
@@ -136,10 +144,11 @@ void fill_translucent(cv::Mat& image, const std::vector<cv::Point>& polygon, con
   cv::addWeighted(overlay, alpha, image, 1 - alpha, 0, image);
 }
 
-void draw_bands(cv::Mat& data_area, const Plot& plot, const std::vector<Curve>& curves, const Style& style) {
+void draw_bands(cv::Mat& data_area, const Plot& plot, const std::vector<Curve>& curves,
+                const std::vector<cv::Scalar>& colours, const Style& style) {
   for (std::size_t i = 0; i < curves.size(); ++i) {
     const auto& points = curves[i].points;
-    const cv::Scalar colour = kPalette[i % kPaletteSize];
+    const cv::Scalar& colour = colours[i];
     if (points.size() == 1) {  // one x: a translucent bar instead of an area
       const CurvePoint& p = points[0];
       const cv::Point2d low = plot.at(p.x, p.low), high = plot.at(p.x, p.high);
@@ -157,10 +166,11 @@ void draw_bands(cv::Mat& data_area, const Plot& plot, const std::vector<Curve>& 
   }
 }
 
-void draw_lines(cv::Mat& data_area, const Plot& plot, const std::vector<Curve>& curves, const Style& style) {
+void draw_lines(cv::Mat& data_area, const Plot& plot, const std::vector<Curve>& curves,
+                const std::vector<cv::Scalar>& colours, const Style& style) {
   for (std::size_t i = 0; i < curves.size(); ++i) {
     const auto& points = curves[i].points;
-    const cv::Scalar colour = kPalette[i % kPaletteSize];
+    const cv::Scalar& colour = colours[i];
     for (std::size_t k = 1; k < points.size(); ++k)
       cv::line(data_area, Plot::fixed(plot.at(points[k - 1].x, points[k - 1].mean)),
                Plot::fixed(plot.at(points[k].x, points[k].mean)), colour, style.line_thickness, cv::LINE_AA,
@@ -187,7 +197,8 @@ int64_t ink_inside(const cv::Rect& box, const Plot& plot, const std::vector<Curv
   return count;
 }
 
-void draw_legend(cv::Mat& image, const Plot& plot, const std::vector<Curve>& curves, const Style& style) {
+void draw_legend(cv::Mat& image, const Plot& plot, const std::vector<Curve>& curves,
+                 const std::vector<cv::Scalar>& colours, const Style& style) {
   const int pad = 8, swatch = 24, row_height = text_size("Ag", style.label_scale, style.thickness).height + 6;
   int text_width = 0;
   for (const Curve& c : curves)
@@ -210,7 +221,7 @@ void draw_legend(cv::Mat& image, const Plot& plot, const std::vector<Curve>& cur
   for (std::size_t i = 0; i < curves.size(); ++i) {
     const int top = frame.y + pad + row_height * static_cast<int>(i);
     const int middle = top + row_height / 2;
-    const cv::Scalar colour = kPalette[i % kPaletteSize];
+    const cv::Scalar& colour = colours[i];
     cv::line(image, {frame.x + pad, middle}, {frame.x + pad + swatch, middle}, colour, style.line_thickness,
              cv::LINE_AA);
     cv::circle(image, {frame.x + pad + swatch / 2, middle}, style.marker_radius, colour, cv::FILLED, cv::LINE_AA);
@@ -223,6 +234,7 @@ void draw_legend(cv::Mat& image, const Plot& plot, const std::vector<Curve>& cur
 struct Labels {
   std::string title, x, y;
   bool legend = false;
+  std::vector<cv::Scalar> colours;  // one per curve
 };
 
 int y_tick_target(int height, const Style& style) {
@@ -257,10 +269,8 @@ void draw_title(cv::Mat& image, const std::string& title, const Plot& plot, cons
 }
 
 cv::Mat draw(const std::vector<Curve>& curves, Axis x_axis, Axis y_axis, const Labels& labels, cv::Size size) {
-  const double scale = std::clamp(std::min(size.width / 800.0, size.height / 500.0), 0.6, 3.0);
-  Style style{scale, 0.42 * scale, 0.5 * scale, 0.62 * scale, std::max(1, static_cast<int>(std::lround(scale))),
-              std::max(1, static_cast<int>(std::lround(2 * scale))),
-              std::max(2, static_cast<int>(std::lround(3 * scale)))};
+  const Style style = style_for(size);
+  const double scale = style.scale;
   cv::Mat image(size, CV_8UC3, cv::Scalar(255, 255, 255));
 
   // Margins from the text they hold; the y tick numbers are measured once ticks are known, so
@@ -292,8 +302,8 @@ cv::Mat draw(const std::vector<Curve>& curves, Axis x_axis, Axis y_axis, const L
     cv::line(image, {plot.area.x, py}, {plot.area.br().x - 1, py}, kGrid, 1);
   }
   cv::Mat data_area = image(plot.area);
-  draw_bands(data_area, plot, curves, style);
-  draw_lines(data_area, plot, curves, style);
+  draw_bands(data_area, plot, curves, labels.colours, style);
+  draw_lines(data_area, plot, curves, labels.colours, style);
   cv::rectangle(image, plot.area.tl() - cv::Point(1, 1), plot.area.br(), kFrame, 1);
 
   for (double v : plot.x.ticks) {
@@ -321,34 +331,102 @@ cv::Mat draw(const std::vector<Curve>& curves, Axis x_axis, Axis y_axis, const L
     draw_text_upwards(image, labels.y, {gap + label_height / 2, plot.area.y + plot.area.height / 2},
                       style.label_scale, style.thickness, kInk);
   if (!labels.title.empty()) draw_title(image, labels.title, plot, style, gap);
-  if (labels.legend) draw_legend(image, plot, curves, style);
+  if (labels.legend) draw_legend(image, plot, curves, labels.colours, style);
   return image;
 }
 
 // ---------------------------------------------------------------------------------------------
-// The picture of `curves` with axes spanning their points and bands (or the fixed y range).
-cv::Mat draw_curves(const std::vector<Curve>& curves, const CurvePlotOptions& options) {
+// Pictures of curves, alone or as small multiples
+
+struct Extent {
   double x_lo = INFINITY, x_hi = -INFINITY, y_lo = INFINITY, y_hi = -INFINITY;
-  for (const Curve& curve : curves)
-    for (const CurvePoint& p : curve.points) {
-      x_lo = std::min(x_lo, p.x), x_hi = std::max(x_hi, p.x);
-      y_lo = std::min({y_lo, p.mean, p.low}), y_hi = std::max({y_hi, p.mean, p.high});
-    }
-  // Values near the ends of the double range have no finite extent to draw (ticks would never end).
-  const auto check_extent = [](const char* axis, double lo, double hi) {
-    if (!std::isfinite(hi - lo) || !std::isfinite(0.04 * (hi - lo) + hi) || !std::isfinite(lo - 0.04 * (hi - lo)))
-      throw Error(std::string("the ") + axis + " values span " + std::to_string(lo) + " to " + std::to_string(hi) +
-                  ": more than a plot can draw");
-  };
-  check_extent("x", x_lo, x_hi);
-  check_extent("y", options.fixed_y ? options.y_min : y_lo, options.fixed_y ? options.y_max : y_hi);
-  Axis y_axis = data_axis(y_lo, y_hi);
+
+  void add(const std::vector<Curve>& curves) {
+    for (const Curve& curve : curves)
+      for (const CurvePoint& p : curve.points) {
+        x_lo = std::min(x_lo, p.x), x_hi = std::max(x_hi, p.x);
+        y_lo = std::min({y_lo, p.mean, p.low}), y_hi = std::max({y_hi, p.mean, p.high});
+      }
+  }
+};
+
+// Values near the ends of the double range have no finite extent to draw (ticks would never end).
+void check_extent(const char* axis, double lo, double hi) {
+  if (!std::isfinite(hi - lo) || !std::isfinite(0.04 * (hi - lo) + hi) || !std::isfinite(lo - 0.04 * (hi - lo)))
+    throw Error(std::string("the ") + axis + " values span " + std::to_string(lo) + " to " + std::to_string(hi) +
+                ": more than a plot can draw");
+}
+
+// The vertical axis of `extent`'s data and bands, or the fixed range.
+Axis y_axis_of(const Extent& extent, const CurvePlotOptions& options) {
+  check_extent("y", options.fixed_y ? options.y_min : extent.y_lo, options.fixed_y ? options.y_max : extent.y_hi);
+  Axis y_axis = data_axis(extent.y_lo, extent.y_hi);
   if (options.fixed_y) {
     y_axis.lo = options.y_min;
     y_axis.hi = options.y_max;
   }
-  const Labels labels{options.title, options.x_label, options.y_label, options.legend};
-  return draw(curves, data_axis(x_lo, x_hi), y_axis, labels, cv::Size(options.width_px, options.height_px));
+  return y_axis;
+}
+
+// One plot of `curves`, the horizontal axis spanning their points, in the given colours.
+cv::Mat draw_curves(const std::vector<Curve>& curves, const std::vector<cv::Scalar>& colours, const Axis& y_axis,
+                    const std::string& title, const CurvePlotOptions& options) {
+  Extent extent;
+  extent.add(curves);
+  check_extent("x", extent.x_lo, extent.x_hi);
+  const Labels labels{title, options.x_label, options.y_label, options.legend, colours};
+  return draw(curves, data_axis(extent.x_lo, extent.x_hi), y_axis, labels,
+              cv::Size(options.width_px, options.height_px));
+}
+
+// The picture of `curves` with axes spanning their points and bands (or the fixed y range).
+cv::Mat draw_curves(const std::vector<Curve>& curves, const CurvePlotOptions& options) {
+  Extent extent;
+  extent.add(curves);
+  std::vector<cv::Scalar> colours;
+  for (std::size_t i = 0; i < curves.size(); ++i) colours.push_back(kPalette[i % kPaletteSize]);
+  return draw_curves(curves, colours, y_axis_of(extent, options), options.title, options);
+}
+
+// Small multiples: one plot per panel, titled with its name, `columns` to a row under the title;
+// one vertical axis for all (so panels compare at a glance), a curve's colour that of its name
+// in every panel.
+cv::Mat draw_panels(const std::vector<CurvePanel>& panels, const CurvePlotOptions& options, int columns) {
+  if (panels.empty()) throw Error("no panels to plot");
+  Extent extent;
+  std::vector<std::string> names;  // every curve name, in order of first appearance
+  for (const CurvePanel& panel : panels) {
+    extent.add(panel.curves);
+    for (const Curve& curve : panel.curves)
+      if (std::find(names.begin(), names.end(), curve.name) == names.end()) names.push_back(curve.name);
+  }
+  const Axis y_axis = y_axis_of(extent, options);
+  const int n = static_cast<int>(panels.size());
+  columns = std::clamp(columns, 1, n);
+  const int rows = (n + columns - 1) / columns;
+  // The picture's title a size above the panels' own.
+  const Style style = style_for(cv::Size(options.width_px, options.height_px));
+  const double title_scale = style.title_scale * 1.3;
+  const int title_band = options.title.empty() ? 0 : text_size("Ag", title_scale, style.thickness).height * 2;
+  cv::Mat image(title_band + rows * options.height_px, columns * options.width_px, CV_8UC3, cv::Scalar(255, 255, 255));
+  for (int i = 0; i < n; ++i) {
+    std::vector<cv::Scalar> colours;
+    for (const Curve& curve : panels[i].curves) {
+      const auto at = std::find(names.begin(), names.end(), curve.name) - names.begin();
+      colours.push_back(kPalette[at % kPaletteSize]);
+    }
+    const cv::Mat plot = draw_curves(panels[i].curves, colours, y_axis, panels[i].name, options);
+    plot.copyTo(image(cv::Rect((i % columns) * options.width_px, title_band + (i / columns) * options.height_px,
+                               options.width_px, options.height_px)));
+  }
+  if (title_band) {
+    cv::Size s = text_size(options.title, title_scale, style.thickness);
+    const double fit = std::min(1.0, 0.98 * image.cols / std::max(1, s.width));  // never cut off
+    s = text_size(options.title, title_scale * fit, style.thickness);
+    draw_text(image, options.title, {(image.cols - s.width) / 2, (title_band - s.height) / 2}, title_scale * fit,
+              style.thickness, kInk);
+  }
+  return image;
 }
 
 std::vector<uint8_t> encode_png(const cv::Mat& image, const std::string& what) {
@@ -365,6 +443,17 @@ std::vector<uint8_t> curve_plot_png(const std::vector<Curve>& curves, const Curv
 
 void save_curve_plot(const std::string& path, const std::vector<Curve>& curves, const CurvePlotOptions& options) {
   const std::vector<uint8_t> png = encode_png(draw_curves(curves, options), path);
+  write_file_atomically(path, png.data(), png.size());
+}
+
+std::vector<uint8_t> panel_plot_png(const std::vector<CurvePanel>& panels, const CurvePlotOptions& options,
+                                    int columns) {
+  return encode_png(draw_panels(panels, options, columns), "the panels");
+}
+
+void save_panel_plot(const std::string& path, const std::vector<CurvePanel>& panels, const CurvePlotOptions& options,
+                     int columns) {
+  const std::vector<uint8_t> png = encode_png(draw_panels(panels, options, columns), path);
   write_file_atomically(path, png.data(), png.size());
 }
 

@@ -27,4 +27,15 @@ std::vector<uint8_t> curve_plot_png(const std::vector<Curve>& curves, const Curv
 // curve_plot_png written atomically to `path`.
 void save_curve_plot(const std::string& path, const std::vector<Curve>& curves, const CurvePlotOptions& options);
 
+// Small multiples as PNG bytes: one plot of options' size per panel, titled with the panel's
+// name, `columns` panels to a row under options.title. The panels share the vertical axis (the
+// fixed range, or all their data and bands) and each spans its own horizontal extent; a curve
+// has the colour of its name in every panel.
+std::vector<uint8_t> panel_plot_png(const std::vector<CurvePanel>& panels, const CurvePlotOptions& options,
+                                    int columns);
+
+// panel_plot_png written atomically to `path`.
+void save_panel_plot(const std::string& path, const std::vector<CurvePanel>& panels, const CurvePlotOptions& options,
+                     int columns);
+
 }  // namespace qte::report

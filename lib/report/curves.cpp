@@ -13,12 +13,14 @@ CurveBuilder::CurveBuilder(CurveColumns columns, Band band) : columns_(std::move
 void CurveBuilder::add(const CsvTable& table) {
   const int x = table.column(columns_.x, true), y = table.column(columns_.y, true);
   const int group = columns_.group.empty() ? -1 : table.column(columns_.group, true);
+  const int panel = columns_.panel.empty() ? -1 : table.column(columns_.panel, true);
   const int low = band_ == Band::ci ? table.column("ci95_low", false) : -1;
   const int high = band_ == Band::ci ? table.column("ci95_high", false) : -1;
   for (std::size_t r = 0; r < table.rows.size(); ++r) {
     const std::string name = group < 0 ? columns_.y : table.rows[r][group];
-    auto [it, added] = group_index_.emplace(name, groups_.size());
-    if (added) groups_.push_back(Group{name, {}});
+    const std::string panel_name = panel < 0 ? std::string() : table.rows[r][panel];
+    auto [it, added] = group_index_.emplace(std::make_pair(panel_name, name), groups_.size());
+    if (added) groups_.push_back(Group{panel_name, name, {}});
     Row row{table.number(r, y)};
     if (low >= 0 && high >= 0) {
       row.has_interval = true;
@@ -57,14 +59,24 @@ CurvePoint CurveBuilder::summarise(double x, const std::vector<Row>& rows) const
 }
 
 std::vector<Curve> CurveBuilder::curves() const {
-  if (groups_.empty()) throw Error("no rows to plot in the input tables");
   std::vector<Curve> curves;
+  for (CurvePanel& panel : panels())
+    for (Curve& curve : panel.curves) curves.push_back(std::move(curve));
+  return curves;
+}
+
+std::vector<CurvePanel> CurveBuilder::panels() const {
+  if (groups_.empty()) throw Error("no rows to plot in the input tables");
+  std::vector<CurvePanel> panels;
+  std::map<std::string, std::size_t> panel_index;
   for (const Group& group : groups_) {
+    auto [it, added] = panel_index.emplace(group.panel, panels.size());
+    if (added) panels.push_back(CurvePanel{group.panel, {}});
     Curve curve{group.name, {}};
     for (const auto& [x, rows] : group.rows_at_x) curve.points.push_back(summarise(x, rows));
-    curves.push_back(std::move(curve));
+    panels[it->second].curves.push_back(std::move(curve));
   }
-  return curves;
+  return panels;
 }
 
 }  // namespace qte::report

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "report/csv.hpp"
@@ -25,9 +26,16 @@ struct Curve {
   std::vector<CurvePoint> points;  // in increasing x
 };
 
+// The curves of one panel of a picture of small multiples (plot-curves --panel: one task each).
+struct CurvePanel {
+  std::string name;  // the panel column's value; empty without one
+  std::vector<Curve> curves;
+};
+
 struct CurveColumns {
   std::string x, y;
   std::string group;  // empty: all rows form one curve
+  std::string panel = {};  // empty: one panel; else one panel per distinct value of this column
 };
 
 class CurveBuilder {
@@ -38,8 +46,12 @@ class CurveBuilder {
   // when a column is missing, or its line and column when a cell is not a finite number.
   void add(const CsvTable& table);
 
-  // The curves in the order in which their groups first appeared. Error when no rows were added.
+  // The curves in the order in which their groups first appeared, of every panel in turn. Error
+  // when no rows were added.
   std::vector<Curve> curves() const;
+  // The panels in the order in which their values first appeared, each with its curves in that
+  // order. Error when no rows were added.
+  std::vector<CurvePanel> panels() const;
 
  private:
   struct Row {
@@ -48,7 +60,7 @@ class CurveBuilder {
     double low = 0, high = 0;
   };
   struct Group {
-    std::string name;
+    std::string panel, name;
     std::map<double, std::vector<Row>> rows_at_x;
   };
   CurvePoint summarise(double x, const std::vector<Row>& rows) const;
@@ -56,7 +68,7 @@ class CurveBuilder {
   CurveColumns columns_;
   Band band_;
   std::vector<Group> groups_;
-  std::map<std::string, std::size_t> group_index_;
+  std::map<std::pair<std::string, std::string>, std::size_t> group_index_;  // by (panel, group)
 };
 
 }  // namespace qte::report

@@ -99,5 +99,21 @@ err=$(plot-curves --x step --y success_rate --output "$tmp/bad.png" "$tmp/empty.
 [ $rc = 1 ] && grep -q "no rows" <<<"$err" || fail "no rows: $rc $err"
 plot-curves --x step --y success_rate --band wide --output "$tmp/bad.png" "$tmp/curves.csv" 2>/dev/null
 [ $? = 2 ] || fail "bad --band accepted"
+
+# --panel: one panel of --size per task, --panel-columns to a row, under a title band.
+awk -F, 'NR == 1 { print "task," $0; next } { print "reach," $0; if ($1 == "qte") print "lift," $0 }' \
+  "$tmp/curves.csv" > "$tmp/tasks.csv"
+plot-curves --x step --y success_rate --group label --panel task --panel-columns 3 --size 300x200 \
+  --title "two tasks" --output "$tmp/panels.png" "$tmp/tasks.csv" || fail "panels: exit $?"
+size=$($py "$tmp/png.py" "$tmp/panels.png" size)
+[ "${size%x*}" = 600 ] && [ "${size#*x}" -gt 200 ] && [ "${size#*x}" -lt 260 ] \
+  || fail "2 panels, 3 to a row, 300x200 each: $size"
+plot-curves --x step --y success_rate --panel task --panel-columns 1 --size 300x200 \
+  --output "$tmp/stacked.png" "$tmp/tasks.csv" || fail "stacked panels: exit $?"
+[ "$($py "$tmp/png.py" "$tmp/stacked.png" size)" = 300x400 ] || fail "1 to a row, no title: $($py "$tmp/png.py" "$tmp/stacked.png" size)"
+err=$(plot-curves --x step --y success_rate --panel task --output "$tmp/bad.png" "$tmp/curves.csv" 2>&1); rc=$?
+[ $rc = 1 ] && grep -q "$tmp/curves.csv: no column 'task'" <<<"$err" || fail "no panel column: $rc $err"
+plot-curves --x step --y success_rate --panel task --panel-columns 0 --output "$tmp/bad.png" "$tmp/tasks.csv" 2>/dev/null
+[ $? = 2 ] || fail "--panel-columns 0 accepted"
 [ -z "$(ls "$tmp" | grep -e bad.png -e '\.tmp\.')" ] || fail "files left behind: $(ls "$tmp")"
 echo "plot-curves ok"

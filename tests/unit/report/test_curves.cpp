@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "common/error.hpp"
 #include "report/curve_plot.hpp"
@@ -168,4 +169,96 @@ TEST(CurvePlot, ALongTitleIsShrunkNotCutOff) {
   EXPECT_GE(left, 3);
   EXPECT_LE(right, image.cols - 4);
   EXPECT_GT(right - left, image.cols / 2);  // shrunk to fit, not to nothing
+}
+
+// Small multiples: rows split by the panel column in order of appearance, each panel with its
+// own curves in order of appearance; without a panel column, one unnamed panel.
+TEST(CurveBuilder, PanelsSplitRowsByTheirColumnInOrderOfAppearance) {
+  const char* table =
+      "task,label,step,success_rate\n"
+      "reach,qte,0,0.5\n"
+      "lift,c2farm,0,0.1\n"
+      "reach,c2farm,0,0.3\n"
+      "lift,qte,0,0.2\n"
+      "lift,qte,0,0.4\n";
+  CurveBuilder builder({"step", "success_rate", "label", "task"}, Band::std_dev);
+  builder.add(parse_csv("tasks.csv", table));
+  const std::vector<CurvePanel> panels = builder.panels();
+  ASSERT_EQ(panels.size(), 2u);
+  EXPECT_EQ(panels[0].name, "reach");
+  EXPECT_EQ(panels[1].name, "lift");
+  ASSERT_EQ(panels[1].curves.size(), 2u);
+  EXPECT_EQ(panels[1].curves[0].name, "c2farm");
+  EXPECT_EQ(panels[1].curves[1].name, "qte");
+  EXPECT_NEAR(panels[1].curves[1].points.at(0).mean, 0.3, 1e-12);  // lift's qte rows only
+  EXPECT_NEAR(panels[0].curves[0].points.at(0).mean, 0.5, 1e-12);
+
+  CurveBuilder one({"step", "success_rate", "label"}, Band::std_dev);
+  one.add(parse_csv("tasks.csv", table));
+  ASSERT_EQ(one.panels().size(), 1u);
+  EXPECT_EQ(one.panels()[0].name, "");
+  EXPECT_EQ(one.panels()[0].curves.size(), 2u);  // every task's rows in the same two curves
+}
+
+namespace {
+
+// Pixels within `tolerance` of a BGR colour in a rectangle of a picture.
+int count_near(const cv::Mat& image, const cv::Rect& where, const cv::Vec3b& colour, int tolerance = 30) {
+  int count = 0;
+  for (int y = where.y; y < where.br().y; ++y)
+    for (int x = where.x; x < where.br().x; ++x) {
+      const cv::Vec3b p = image.at<cv::Vec3b>(y, x);
+      count += std::abs(p[0] - colour[0]) + std::abs(p[1] - colour[1]) + std::abs(p[2] - colour[2]) < tolerance;
+    }
+  return count;
+}
+
+// The first row (from the top) of a rectangle holding a pixel near `colour`; -1 if none.
+int first_row_near(const cv::Mat& image, const cv::Rect& where, const cv::Vec3b& colour) {
+  for (int y = where.y; y < where.br().y; ++y)
+    if (count_near(image, cv::Rect(where.x, y, where.width, 1), colour, 12)) return y;
+  return -1;
+}
+
+}  // namespace
+
+// Panels laid out `columns` to a row under the title, each of the asked size; a curve keeps the
+// colour of its name in every panel (c2farm is second in the first panel, first alone in the
+// second: orange in both), and the panels share one vertical axis, so equal values are drawn at
+// equal heights whatever else a panel holds.
+TEST(CurvePlot, PanelsShareTheVerticalAxisAndEachCurveKeepsItsColour) {
+  const char* table =
+      "task,label,step,success_rate\n"
+      "reach,qte,0,0.9\nreach,qte,100,0.9\n"
+      "reach,c2farm,0,0.3\nreach,c2farm,100,0.3\n"
+      "lift,c2farm,0,0.3\nlift,c2farm,5000,0.3\n"
+      "stack,qte,0,0.1\nstack,qte,10,0.1\n";
+  CurveBuilder builder({"step", "success_rate", "label", "task"}, Band::none);
+  builder.add(parse_csv("tasks.csv", table));
+  CurvePlotOptions options;  // 800x500 a panel: lines 2 pixels wide
+  options.title = "three tasks";
+  const std::vector<uint8_t> png = panel_plot_png(builder.panels(), options, 2);
+  EXPECT_EQ(panel_plot_png(builder.panels(), options, 2), png);
+  const cv::Mat image = cv::imdecode(png, cv::IMREAD_COLOR);
+  ASSERT_EQ(image.cols, 1600);                  // 2 panels to a row
+  ASSERT_GT(image.rows, 1000);                  // 2 rows, and a title band above them
+  const int band = image.rows - 1000;
+  const cv::Rect reach(0, band, 800, 500), lift(800, band, 800, 500), stack(0, band + 500, 800, 500),
+      empty(800, band + 500, 800, 500);
+  const cv::Vec3b blue(180, 119, 31), orange(14, 127, 255);
+  EXPECT_GT(count_near(image, reach, blue), 100);
+  EXPECT_GT(count_near(image, reach, orange), 100);
+  EXPECT_EQ(count_near(image, lift, blue), 0);
+  EXPECT_GT(count_near(image, lift, orange), 100);   // c2farm, orange as in the first panel
+  EXPECT_GT(count_near(image, stack, blue), 100);    // qte, blue as in the first panel
+  EXPECT_EQ(count_near(image, stack, orange), 0);
+  EXPECT_EQ(count_near(image, empty, cv::Vec3b(255, 255, 255), 1), 800 * 500);  // nothing drawn
+  // c2farm's 0.3 at the same height in both panels (the y axis spans 0.1 to 0.9 in each).
+  const int in_reach = first_row_near(image, reach, orange), in_lift = first_row_near(image, lift, orange);
+  ASSERT_GE(in_reach, 0);
+  EXPECT_NEAR(in_reach, in_lift, 1);
+  // The picture's title is inked in the band above the panels.
+  cv::Mat gray;
+  cv::cvtColor(image(cv::Rect(0, 0, image.cols, band)), gray, cv::COLOR_BGR2GRAY);
+  EXPECT_GT(cv::countNonZero(gray < 128), 50);
 }
