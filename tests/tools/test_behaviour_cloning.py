@@ -20,8 +20,8 @@ import tempfile
 
 import numpy as np
 
-TOOLS = os.environ.get("QTE_TOOLS") or "/work/main/build/tools"
-SOURCE = os.environ.get("QTE_SOURCE") or "/work/main"
+SOURCE = os.environ.get("QTE_SOURCE") or os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+TOOLS = os.environ.get("QTE_TOOLS") or os.path.join(SOURCE, "build", "tools")
 sys.path.insert(0, os.path.join(SOURCE, "lib", "python"))
 import qte_stream as read_stream  # noqa: E402
 tmp = tempfile.mkdtemp(prefix="qte_bc_")

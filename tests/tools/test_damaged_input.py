@@ -3,7 +3,8 @@ one line on stderr naming the file, record index and byte offset and what was ex
 leave no output file (and no temporary file) behind."""
 import os, struct, subprocess, sys, tempfile, zlib
 
-TOOLS = os.environ.get("QTE_TOOLS", "build/tools")
+SOURCE = os.environ.get("QTE_SOURCE") or os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+TOOLS = os.environ.get("QTE_TOOLS") or os.path.join(SOURCE, "build", "tools")
 tmp = tempfile.mkdtemp(prefix="qte_damage_")
 failures = []
 

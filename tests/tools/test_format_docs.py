@@ -7,7 +7,7 @@ import os
 import re
 import sys
 
-SOURCE = os.environ.get("QTE_SOURCE") or "/work/main"
+SOURCE = os.environ.get("QTE_SOURCE") or os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 spec = open(os.path.join(SOURCE, "formats", "record-stream.md"), encoding="utf-8").read()
 man = open(os.path.join(SOURCE, "man", "qte-stream.5"), encoding="utf-8").read()
 

@@ -8,8 +8,8 @@ import re
 import subprocess
 import sys
 
-TOOLS = os.environ.get("QTE_TOOLS") or "/work/main/build/tools"
-SOURCE = os.environ.get("QTE_SOURCE") or "/work/main"
+SOURCE = os.environ.get("QTE_SOURCE") or os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+TOOLS = os.environ.get("QTE_TOOLS") or os.path.join(SOURCE, "build", "tools")
 DOC = os.path.join(SOURCE, "formats", "record-stream.md")
 LINE = re.compile(r"([0-9a-f]{8}): ((?:[0-9a-f]{2} ){0,15}[0-9a-f]{2}) +(.{1,16})")
 

@@ -12,11 +12,11 @@ import os, random, re, struct, subprocess, sys, tempfile, time, zlib
 
 import numpy as np
 
-SOURCE = os.environ.get("QTE_SOURCE", ".")
+SOURCE = os.environ.get("QTE_SOURCE") or os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 sys.path.insert(0, os.path.join(SOURCE, "lib", "python"))
 import qte_stream as read_stream  # noqa: E402
 
-TOOLS = os.environ.get("QTE_TOOLS", "build/tools")
+TOOLS = os.environ.get("QTE_TOOLS") or os.path.join(SOURCE, "build", "tools")
 LIMIT = os.environ.get("QTE_MUTATIONS", "12")
 TIMEOUT_S = 120
 tmp = tempfile.mkdtemp(prefix="qte_mutations_")

@@ -15,8 +15,8 @@ import tempfile
 
 import numpy as np
 
-TOOLS = os.environ.get("QTE_TOOLS") or "/work/main/build/tools"
-SOURCE = os.environ.get("QTE_SOURCE") or "/work/main"
+SOURCE = os.environ.get("QTE_SOURCE") or os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+TOOLS = os.environ.get("QTE_TOOLS") or os.path.join(SOURCE, "build", "tools")
 tmp = tempfile.mkdtemp(prefix="qte_pyreader_")
 failures = []
 
