@@ -2,6 +2,7 @@
 
 #include <iostream>
 #include <map>
+#include <memory>
 #include <set>
 
 #include "cli/command.hpp"
@@ -24,8 +25,14 @@ static cli::Usage usage() {
       "field layout) as it is read; the first damage stops the dump with one line naming the "
       "file, record index and byte offset.",
       "With --json each record becomes one JSON object per line (JSON Lines), for jq and "
-      "scripts. With --npy every array is also exported as DIR/<index>.<type>.<field>.npy "
-      "(index zero-padded to 6 digits) for NumPy.",
+      "scripts.",
+      "With --npy the fields of the shown records are also exported for NumPy: one stacked array "
+      "per record type and field, DIR/<type>.<field>.npy of shape [N, ...] over the N records of "
+      "that type (e.g. obs.front.rgb.npy of shape [N, H, W, 3]; a str field is a 1-d bytes array "
+      "|S<longest>). Row i of every file of a type comes from the same record. A field missing "
+      "from some records of its type, or whose dtype or shape changes, cannot be stacked and is "
+      "written per record instead, as DIR/<index>.<type>.<field>.npy (the record's index "
+      "zero-padded to 6 digits); --per-record writes every field that way.",
       "With --pcd every camera of the shown 'obs' and 'frame' records is also written as "
       "DIR/<index>.<camera>.pcd: the world-frame point cloud (the stored points, or points "
       "rebuilt from depth) with its colours, binary XYZRGB, organized as the image (NaN where a "
@@ -37,7 +44,8 @@ static cli::Usage usage() {
       {"type", "T", "show only records of type T", "", true},
       {"values", "N", "values shown per field; -1 shows all", "6"},
       {"all-values", "", "show every value (same as --values -1)", ""},
-      {"npy", "DIR", "also export every field of the shown records as .npy files into DIR", ""},
+      {"npy", "DIR", "also export the fields of the shown records into DIR: one stacked .npy array per record type and field", ""},
+      {"per-record", "", "with --npy, write one .npy file per record and field instead of stacked arrays", ""},
       {"pcd", "DIR", "also export every camera's point cloud of the shown observations as .pcd files into DIR", ""},
       {"summary", "", "print only a count of records and bytes per type at the end", ""},
       {"max-record-bytes", "N", "treat a record payload or decompressed field larger than N bytes as damage",
@@ -47,8 +55,8 @@ static cli::Usage usage() {
       {"stream-dump demos.rec", "list every record of a file with its fields"},
       {"stream-dump --json --type obs demos.rec | jq '.fields[].name'",
        "field names of the observations"},
-      {"sim-step --task reach_target < actions.rec | stream-dump --npy frames/",
-       "export what the simulator emits as NumPy arrays"},
+      {"stream-dump --summary --type obs --npy arrays/ demos.rec && ls arrays/",
+       "the observations as stacked NumPy arrays (arrays/obs.front.rgb.npy, ...)"},
       {"stream-dump --summary --pcd clouds/ episode.rec && pcl_viewer clouds/000000.front.pcd",
        "look at the first observation's point cloud in PCL's viewer"},
   };
@@ -71,6 +79,9 @@ static void run(const cli::Arguments& args) {
   const std::string npy_dir = args.text("npy"), pcd_dir = args.text("pcd");
   for (const std::string& dir : {npy_dir, pcd_dir})
     if (!dir.empty()) make_output_directory(dir);
+  if (args.flag("per-record") && npy_dir.empty()) throw UsageError("--per-record goes with --npy DIR");
+  std::unique_ptr<stream::NpyExport> npy;
+  if (!npy_dir.empty()) npy = std::make_unique<stream::NpyExport>(npy_dir, args.flag("per-record"));
   stream::ReadOptions read_options;
   if (args.integer("max-record-bytes") <= 0) throw UsageError("--max-record-bytes must be positive");
   read_options.max_record_bytes = static_cast<uint64_t>(args.integer("max-record-bytes"));
@@ -91,18 +102,14 @@ static void run(const cli::Arguments& args) {
       if (!pcd_dir.empty() && (record->type() == "obs" || record->type() == "frame"))
         for (const auto& camera : voxels::camera_clouds(*record))
           point_clouds::write_pcd(pcd_dir + "/" + index + "." + camera.camera + ".pcd", camera);
+      if (npy) npy->add(*record);
       if (args.flag("summary")) continue;
       if (args.flag("json")) stream::print_record_json(std::cout, *record, bytes, inspect);
       else stream::print_record_text(std::cout, *record, bytes, inspect);
-      if (!npy_dir.empty()) {
-        for (const auto& field : record->fields())
-          stream::write_npy(npy_dir + "/" + index + "." + record->type() + "." + field.name() +
-                                ".npy",
-                            field);
-      }
       flush_or_stop();
     }
   }
+  if (npy) npy->finish();
   if (args.flag("summary")) {
     for (const auto& [type, total] : totals)
       std::cout << type << "\t" << total.first << " records\t" << total.second << " bytes\n";

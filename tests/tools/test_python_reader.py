@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""The installed qte_stream module (lib/python/qte_stream.py), stream-dump --json and stream-dump --npy all give back, bit for bit,
+"""The installed qte_stream module (lib/python/qte_stream.py), stream-dump --json and stream-dump --npy
+(per record, and stacked per record type and field as np.stack makes them) all give back, bit for bit,
 what stream-pack wrote: every dtype (extremes, NaN, infinities, -0), 0-d scalars, empty arrays,
 non-ASCII text and a zstd-compressed field. Damage makes the Python reader raise StreamError.
 Run with a python3 that has NumPy (ctest uses /usr/bin/python3)."""
@@ -157,19 +158,94 @@ for i, (line, (rtype, fields)) in enumerate(zip(lines, records)):
             got = f"unconvertible values ({e}): {f['values'][:8]}"
         same(f"json record {i} field {f['name']}", got, want)
 
-# --- 3. stream-dump --npy ---------------------------------------------------------------------
+# --- 3. stream-dump --npy --per-record: one file per record and field ------------------------
 npy_dir = os.path.join(tmp, "npy")
-tool("stream-dump", "--npy", npy_dir, path)
+tool("stream-dump", "--npy", npy_dir, "--per-record", path)
 expected = {f"{i:06d}.{rtype}.{name}.npy": want
             for i, (rtype, fields) in enumerate(records) for name, want in fields.items()}
 if sorted(os.listdir(npy_dir)) != sorted(expected):
-    failures.append(f"--npy wrote {sorted(os.listdir(npy_dir))}, expected {sorted(expected)}")
+    failures.append(f"--npy --per-record wrote {sorted(os.listdir(npy_dir))}, expected {sorted(expected)}")
 for file, want in expected.items():
     if os.path.exists(os.path.join(npy_dir, file)):
         got = np.load(os.path.join(npy_dir, file))
         if isinstance(want, str):  # text is exported as one bytes string (|S<n>)
             got = got.item().decode("utf-8") if got.dtype.kind == "S" and got.ndim == 0 else got
-        same(f"--npy {file}", got, want)
+        same(f"--npy --per-record {file}", got, want)
+
+
+# --- 3b. stream-dump --npy: one stacked array per record type and field -----------------------
+def stacked_expectation(stream_path, only_type=None):
+    """The files --npy should write for a stream, from the Python reader and np.stack: a field in
+    every record of its type with one dtype and shape (text: any length) is one array [N, ...];
+    any other field is one file per record."""
+    by_type = {}
+    for record in read_stream.read_records(stream_path):
+        if only_type in (None, record.type):
+            by_type.setdefault(record.type, []).append(record)
+    files = {}
+    for rtype, recs in by_type.items():
+        for name in dict.fromkeys(n for r in recs for n in r.fields):
+            values = [r.fields.get(name) for r in recs]
+            if all(isinstance(v, str) for v in values):
+                width = max(1, max(len(v.encode()) for v in values))
+                files[f"{rtype}.{name}.npy"] = np.array([v.encode() for v in values], f"S{width}")
+            elif all(isinstance(v, np.ndarray) and v.dtype == values[0].dtype
+                     and v.shape == values[0].shape for v in values):
+                files[f"{rtype}.{name}.npy"] = np.stack(values)
+            else:
+                for r in recs:
+                    if name in r.fields:
+                        files[f"{r.index:06d}.{rtype}.{name}.npy"] = r.fields[name]
+    return files
+
+
+def check_stacked(what, stream_path, only_type=None):
+    out = os.path.join(tmp, "stacked_" + what.replace(" ", "_"))
+    tool("stream-dump", "--summary", "--npy", out, *(["--type", only_type] if only_type else []), stream_path)
+    want_files = stacked_expectation(stream_path, only_type)
+    if sorted(os.listdir(out)) != sorted(want_files):
+        failures.append(f"--npy ({what}) wrote {sorted(os.listdir(out))}, expected {sorted(want_files)}")
+    for file, want in want_files.items():
+        if os.path.exists(os.path.join(out, file)):
+            got = np.load(os.path.join(out, file))
+            if isinstance(want, str):
+                got = got.item().decode("utf-8") if got.dtype.kind == "S" and got.ndim == 0 else got
+            same(f"--npy ({what}) {file}", got, want)
+    return want_files
+
+
+# Four observations and two episode records interleaved: equal fields stack; a field missing
+# from the first observation, or whose shape changes, goes per record; text of any length stacks.
+rng = np.random.default_rng(3)
+mixed = []
+for i in range(4):
+    rgb = rng.integers(0, 256, (4, 5, 3), dtype=np.uint8)
+    np.save(os.path.join(tmp, f"rgb{i}.npy"), rgb)
+    ragged = ",".join(["0.5"] * (2 if i < 2 else 3))
+    args = ["obs", "front.rgb=@" + os.path.join(tmp, f"rgb{i}.npy"), f"step:i32={i}",
+            "task=" + "reach_target"[:i * 4], f"ragged:f32[{2 if i < 2 else 3}]={ragged}"]
+    if i > 0:
+        args.append(f"late:i16={-i}")
+    mixed.append(tool("stream-pack", *args))
+    if i % 2:
+        mixed.append(tool("stream-pack", "episode", f"success:u8={i % 3}", f"seed:i64={10 ** 12 + i}"))
+mixed_path = os.path.join(tmp, "mixed.rec")
+with open(mixed_path, "wb") as f:
+    f.write(b"".join(mixed))
+files = check_stacked("mixed", mixed_path)
+for name, shape in [("obs.front.rgb.npy", (4, 4, 5, 3)), ("obs.step.npy", (4,)), ("episode.seed.npy", (2,))]:
+    if name not in files or files[name].shape != shape:
+        failures.append(f"--npy (mixed): {name} not stacked to {shape}")
+if not {"000000.obs.ragged.npy", "000001.obs.late.npy"} <= set(files):
+    failures.append("--npy (mixed): ragged and late fields not written per record")
+check_stacked("one record per type", path)  # every field of each record: N = 1
+# A real episode of observations (zstd-compressed, when the reader can decompress them).
+episode = os.path.join(tmp, "episode.rec")
+tool("demo-record", "--task", "reach_target", "--episodes", "1", "--image-size", "32x32",
+     *(["--compress"] if have_zstd else []), "--output", episode)
+files = check_stacked("demo-record", episode, "obs")
+if files.get("obs.front.rgb.npy", np.zeros(0)).shape[1:] != (32, 32, 3):
+    failures.append("--npy (demo-record): no stacked obs.front.rgb.npy of shape [N, 32, 32, 3]")
 
 # --- 4. damage: StreamError, nothing else -----------------------------------------------------
 plain, second = stream[:offsets[-1]], offsets[1]  # all but the compressed record
@@ -191,7 +267,7 @@ for what, data, where in [("truncated payload", plain[:-5], f"record {len(record
         failures.append(f"{what}: {type(e).__name__} instead of StreamError: {e}")
 
 print("\n".join(failures) or f"{len(records)} records read back bit for bit by the installed qte_stream, "
-      "stream-dump --json and stream-dump --npy; damage raises StreamError")
+      "stream-dump --json and stream-dump --npy (stacked and per record); damage raises StreamError")
 if failures:
     sys.exit(f"FAIL ({len(failures)} mismatches; files kept in {tmp})")
 shutil.rmtree(tmp)
