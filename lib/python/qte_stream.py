@@ -1,13 +1,15 @@
 #!/usr/bin/env python3
-"""qte_stream: reads QTE record streams (formats/record-stream.md) with the standard library and
-NumPy (Debian's python3-numpy; a python3 from elsewhere may lack it).
+"""qte_stream: reads QTE record streams (formats/record-stream.md) with the standard library,
+NumPy (Debian's python3-numpy) and, for zstd-compressed fields, zstandard (Debian's
+python3-zstandard); a python3 from elsewhere (pyenv, a venv) may lack them.
 
     import qte_stream
     for record in qte_stream.read_records("demos.rec"):
         print(record.index, record.type, record.fields["front.rgb"].shape)
 
 `make install` puts this module where Debian's python3 finds it (/usr/local/lib/python3.X/
-dist-packages); from a checkout, add lib/python to sys.path or PYTHONPATH.
+dist-packages); under another prefix, set PYTHONPATH=PREFIX/lib/python3.X/dist-packages, and
+from a checkout add lib/python to sys.path or PYTHONPATH.
 
 Records are checked as the C++ reader checks them; the first damage raises StreamError
 ("FILE: record I at byte O: what"). Arrays are read-only NumPy views of the payload (no copy);

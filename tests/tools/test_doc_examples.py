@@ -2,8 +2,7 @@
 """Runs the shell examples of README.md and docs/*.md that are marked runnable, so that a changed
 option or output breaks the build rather than the reader.
 
-A runnable example is a fenced block whose info string is `sh runnable` (`sh runnable slow` for
-the ones that train for minutes: test_doc_examples_slow.py runs those). The blocks of one
+A runnable example is a fenced block whose info string is `sh runnable`. The blocks of one
 document run in order, each as `bash -euo pipefail`, in one scratch directory per document that
 starts empty, with the built programs first on PATH; every document makes its own inputs. A
 block that fails is reported with its document and line. The README's learning pipeline must
@@ -29,7 +28,7 @@ def documents():
 
 
 def runnable_blocks(path):
-    """(line number, flags, text) of each block fenced as `sh runnable ...` in a Markdown file."""
+    """(line number, text) of each block fenced as `sh runnable` in a Markdown file."""
     blocks, inside, start, flags, lines = [], False, 0, [], []
     with open(path, encoding="utf-8") as f:
         for number, line in enumerate(f, 1):
@@ -40,7 +39,7 @@ def runnable_blocks(path):
             elif m and inside:
                 inside = False
                 if flags and "runnable" in flags:
-                    blocks.append((start, flags, "".join(lines)))
+                    blocks.append((start, "".join(lines)))
             elif inside:
                 lines.append(line)
     return blocks
@@ -61,17 +60,17 @@ def check_readme_learning(scratch, output, failures):
     print(f"README.md learning pipeline: {max(steps or [0])} learner steps; evaluation:\n{output.strip()}")
 
 
-def main(slow):
+def main():
     env = dict(os.environ, PATH=os.path.abspath(TOOLS) + os.pathsep + os.environ.get("PATH", ""))
     failures, ran = [], 0
     for doc in documents():
         name = os.path.relpath(doc, SOURCE)
-        blocks = [b for b in runnable_blocks(doc) if ("slow" in b[1]) == slow]
+        blocks = runnable_blocks(doc)
         if not blocks:
             continue
         scratch = tempfile.mkdtemp(prefix="qte_doc_")
         outputs = []
-        for line, _, text in blocks:
+        for line, text in blocks:
             ran += 1
             try:
                 r = subprocess.run(["bash", "-euo", "pipefail", "-c", text], cwd=scratch, env=env,
@@ -85,15 +84,15 @@ def main(slow):
                                 f"{r.stdout[-2000:]}{r.stderr[-2000:]}")
                 break  # later blocks of this document may need this one's files
         else:
-            if name == "README.md" and any("qattn-train" in text for _, _, text in blocks):
+            if name == "README.md" and any("qattn-train" in text for _, text in blocks):
                 check_readme_learning(scratch, "".join(outputs), failures)
         shutil.rmtree(scratch, ignore_errors=True)
     if ran == 0:
-        failures.append(f"no block marked 'sh runnable{' slow' if slow else ''}' in README.md or docs/")
+        failures.append("no block marked 'sh runnable' in README.md or docs/")
     print("\n".join(failures) or f"{ran} runnable examples ran as written")
     if failures:
         sys.exit(f"FAIL ({len(failures)})")
 
 
 if __name__ == "__main__":
-    main(slow=False)
+    main()
