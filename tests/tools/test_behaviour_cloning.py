@@ -10,7 +10,7 @@ About 4 minutes on 2 cores. Run with a python3 that has NumPy (ctest uses /usr/b
 The scenes are fixed (--scenes any, seeds 1 and 99: the ones this test was written on). How
 well 300 steps clone 20 demonstrations depends on the draw: on demo-record's demo scene set
 (seeds 1 and 99) every learner variant measured reached 12-13/20 (published settings, no
-clipping, norm clipping, beta 1), on these 18/20 (README, the learner)."""
+clipping, norm clipping, beta 1), on these 18/20 (docs/learner.md)."""
 import importlib.util
 import os
 import shutil
