@@ -51,7 +51,7 @@ make -s -C examples reach_target RUNS="$(realpath "$out")/runs" BUILD="$(dirname
   DEMOS=5 PRETRAIN=60 ENV_STEPS=30 EVAL_EVERY=30 CHUNK_EPISODES=5 EVAL_EPISODES=10 CHECKPOINT_EVERY=20 BATCH=16
 run=$out/runs/reach_target/qte-k10-t10-seed0
 cat "$run/eval.csv" >&2
-stream-cat --type obs --where step=0 --head 1 "$run/chunks/0000.rec" \
+stream-cat --type obs --where step=0 --head 1 "$run/demos.rec" \
   | qte-select --checkpoint "$run/ckpt/latest.rec" --k 10 --png "$out/attention" > /dev/null
 ls "$run/curve.png" "$out"/attention/*.png >&2
 

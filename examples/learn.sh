@@ -4,10 +4,11 @@
 #   demo-record | keyframe                      demonstrations -> replay.rec (once)
 #   qattn-train --follow replay.rec &           the learner: trains as replay.rec grows,
 #                                               writes ckpt/step-N.rec and ckpt/latest.rec
-#   sim-step < loop | qte-select --reload | plan-path | tee loop | keyframe --agent --append
-#                                               the actor: a closed pipeline through a FIFO;
-#                                               every finished episode is appended to replay.rec
-#                                               (ACTORS of them at once, each on its own chunk)
+#   sim-step --gate < loop | qte-select --reload | plan-path | tee loop | keyframe --agent --append
+#                                               the actor: a closed pipeline through a FIFO, up
+#                                               for the whole run, running chunks of episodes as
+#                                               the loop opens them; every finished episode is
+#                                               appended to replay.rec (ACTORS of them at once)
 #   sim-step | qte-select (greedy) | plan-path | episode-stats
 #                                               evaluation on held-out seeds after each chunk
 #
@@ -18,15 +19,18 @@
 # Usage: learn.sh TASK RUN_DIR   (settings from the environment; see examples/Makefile)
 # Resumable: finished chunks and evaluations are kept, the learner resumes from its last
 # checkpoint; an interrupted chunk is run again (its finished episodes stay in the replay).
+# A learner that dies stops the run at once with a line naming it, how it ended and its last
+# log line; so does a chunk whose actor fails twice.
 #
 # ACTORS=N runs N actor pipelines side by side, each on its own chunk of episodes (chunk c
 # explores the scenes of seed SEED * 100000 + c, whichever actor runs it), all appending to
 # the one replay file the learner follows (whole records under a lock; an episode's frames
 # come before its transitions, and episodes are told apart by their keys). A machine with more
-# cores collects experience N times as fast. With N > 1 the order in which episodes reach the
-# replay depends on timing, so a run is no longer a function of its seed alone. An actor that
-# dies (killed, out of memory) costs only its own chunk: the others finish theirs and the
-# chunk is run again in the next round (twice failed: the run stops).
+# cores collects experience N times as fast. The learner and the actors run side by side, so
+# which checkpoint acts in an episode and which transitions a batch draws depend on timing:
+# a run's counts of steps follow from its settings and seed, its bytes do not. An actor that
+# dies (killed, out of memory) costs only its own chunk: it is started again on that chunk
+# (twice failed: the run stops).
 #
 # ROLE=learner / ROLE=actor (ACTOR_INDEX=i of ACTORS) split one run over processes that meet
 # only through RUN_DIR, for a cluster (examples/slurm/): the learner role records the
@@ -41,7 +45,7 @@ task=$1 run=$2
 : "${ARCH:=light}" "${BATCH:=32}" "${RATIO:=0.5}" "${PRETRAIN:=200}" "${START_AFTER:=0}"
 : "${LEARNER_THREADS:=1}" "${EPSILON:=0.1}" "${ROTATION_NOISE:=1}" "${CHECKPOINT_EVERY:=25}" "${LABEL:=k$ACT_K-$TARGET_K}"
 : "${N_STEP:=1}" "${ACTORS:=1}" "${CPU_BUDGET:=0}" "${K_MARGIN:=0.02}" "${K_MAX:=10}" "${ROLE:=all}" "${ACTOR_INDEX:=0}"
-mkdir -p "$run/chunks" "$run/eval"
+mkdir -p "$run/actors" "$run/eval"
 # Adaptive K (ACT_K or TARGET_K 'auto'): each node expands the voxels within K_MARGIN of its
 # best Q, at most K_MAX; the options go only to the programs whose K is 'auto'.
 branching() {  # K -> the options that go with it
@@ -49,12 +53,16 @@ branching() {  # K -> the options that go with it
 }
 act_branching=$(branching "$ACT_K") target_branching=$(branching "$TARGET_K")
 log() { printf '%s %s\n' "$(date +%H:%M:%S)" "$*" >&2; }
-# The time a run spends training, up to each evaluation and summed over resumptions
-# (evaluations excluded; an interrupted chunk's time is not counted: the chunk is run again):
-# train_s, wall-clock seconds, and cpu_s, the processor seconds of the run's own processes
-# (the learner, the actors, the demonstrations), which other work on the machine leaves alone.
-clock=$(date +%s) ticks=$(getconf CLK_TCK) eval_ticks=0
-cpu_base=$(cat "$run/cpu_seconds" 2>/dev/null || echo 0)
+# Processor time of the run, split by role, summed over resumptions (evaluations and the failure
+# analysis excluded), in ticks in cpu_ticks ("demos pretrain learner actor other"): demos,
+# the demonstrations; pretrain and learner, the learner process before and after its first
+# checkpoint; actor, the actor pipelines; other, this script and the programs it calls.
+# train_s: wall-clock seconds up to each evaluation (evaluations excluded).
+clock=$(date +%s) ticks=$(getconf CLK_TCK) learner=
+cpu_base=(0 0 0 0 0)
+[ ! -f "$run/cpu_ticks" ] || read -r -a cpu_base < "$run/cpu_ticks"
+demos_ticks=0 eval_ticks=0 pretrain_ticks=0 reaped_actor_ticks=0
+declare -A actor_pids=() actor_ticks=()
 stat_ticks() {  # PID FIELD... : the sum of those fields of /proc/PID/stat (0 once it is gone)
   local stat fields n=0 i
   stat=$(cat "/proc/$1/stat" 2>/dev/null) || { echo 0; return; }
@@ -63,73 +71,161 @@ stat_ticks() {  # PID FIELD... : the sum of those fields of /proc/PID/stat (0 on
   for i in "$@"; do n=$(( n + fields[i - 3] )); done
   echo "$n"
 }
-# Learner (utime + stime) and finished children of this shell (cutime + cstime).
-run_ticks() { echo $(( $(stat_ticks "$learner" 14 15) + $(stat_ticks $$ 16 17) - eval_ticks )); }
-cpu_seconds() { echo $(( cpu_base + $(run_ticks) / ticks )); }
+tree_ticks() {  # PID: its processor ticks and those of its live descendants (with what they reaped)
+  local n c
+  n=$(stat_ticks "$1" 14 15 16 17)
+  for c in $(pgrep -P "$1"); do n=$(( n + $(tree_ticks "$c") )); done
+  echo "$n"
+}
+shell_ticks() { stat_ticks $$ 14 15 16 17; }  # this script and every child it has reaped
+cpu_roles() {  # -> ticks of "demos pretrain learner actor other", this run so far
+  local learner_now i actors=$reaped_actor_ticks reaped=$reaped_actor_ticks
+  learner_now=$(stat_ticks "$learner" 14 15)
+  for i in "${!actor_pids[@]}"; do  # an actor that has ended is in shell_ticks with its last reading
+    if kill -0 "${actor_pids[$i]}" 2>/dev/null; then actor_ticks[$i]=$(tree_ticks "${actor_pids[$i]}")
+    else reaped=$(( reaped + ${actor_ticks[$i]:-0} )); fi
+    actors=$(( actors + ${actor_ticks[$i]:-0} ))
+  done
+  echo $(( cpu_base[0] + demos_ticks )) $(( cpu_base[1] + pretrain_ticks )) \
+    $(( cpu_base[2] + learner_now - pretrain_ticks )) $(( cpu_base[3] + actors )) \
+    $(( cpu_base[4] + $(shell_ticks) - eval_ticks - demos_ticks - reaped ))
+}
+cpu_seconds() { cpu_roles | awk -v t="$ticks" '{ print int(($1 + $2 + $3 + $4 + $5) / t) }'; }
 count_training_time() {
   local now; now=$(date +%s)
   echo $(( $(cat "$run/train_seconds" 2>/dev/null || echo 0) + now - clock )) > "$run/train_seconds.tmp"
   mv "$run/train_seconds.tmp" "$run/train_seconds"
-  cpu_seconds > "$run/cpu_seconds.tmp"
-  mv "$run/cpu_seconds.tmp" "$run/cpu_seconds"
+  cpu_roles > "$run/cpu_ticks.tmp"
+  mv "$run/cpu_ticks.tmp" "$run/cpu_ticks"
   clock=$now
 }
+# The CSV columns of the processor time: cpu_s, then cpu_<role>_s.
+cpu_columns() {
+  awk -v t="$ticks" '{ printf "--column cpu_s=%d --column cpu_demos_s=%.1f --column cpu_pretrain_s=%.1f", ($1 + $2 + $3 + $4 + $5) / t, $1 / t, $2 / t
+                       printf " --column cpu_learner_s=%.1f --column cpu_actor_s=%.1f --column cpu_other_s=%.1f\n", $3 / t, $4 / t, $5 / t }' "$run/cpu_ticks"
+}
 # CPU_BUDGET > 0: a budget in processor seconds as well (1200: the paper's "10 minutes",
-# on 2 cores): once it is spent no chunk starts, and the final evaluation takes the learner's
-# newest checkpoint as it stands (the learner is not waited for: its speed is part of what
-# the budget measures).
+# on 2 cores). The actor is paced by the learner: before each chunk it waits for the learner
+# steps the replay ratio allows, so a run's environment and learner steps follow from its
+# settings and seed, not from how the machine shares its cores. Once the budget is spent no
+# chunk starts, and the final evaluation takes the learner's newest checkpoint as it stands.
 out_of_budget() { [ "$CPU_BUDGET" -gt 0 ] && [ "$(cpu_seconds)" -ge "$CPU_BUDGET" ]; }
 
-# One chunk of exploring episodes through the closed loop -> chunks/NNNN.rec; its episodes are
-# appended to `actor_replay` as they finish.
+# A process that ended, in words: "exit status N" or "killed by signal NAME".
+describe_status() {
+  if [ "$1" -gt 128 ]; then echo "killed by signal $(kill -l $(( $1 - 128 )) 2>/dev/null || echo $(( $1 - 128 )))"
+  else echo "exit status $1"; fi
+}
+# The learner must live as long as the run: once it has died the run stops at once, naming it
+# (resumable like any interrupted run: the learner goes on from its newest checkpoint).
+check_learner() {
+  [ -n "$learner" ] || return 0  # a split run's actor: the learner runs elsewhere
+  kill -0 "$learner" 2>/dev/null && return 0
+  local status=0
+  wait "$learner" 2>/dev/null || status=$?
+  log "$task $LABEL seed $SEED: the learner (qattn-train, pid $learner) died, $(describe_status "$status"); last line of $run/train.log: $(tail -1 "$run/train.log")"
+  exit 1
+}
+kill_tree() {  # PID...: each process and its descendants, children first
+  local p
+  for p in "$@"; do kill_tree $(pgrep -P "$p"); kill "$p" 2>/dev/null || true; done
+}
+
+# The actor pipelines. Each stays up for the whole run (LibTorch starts once per actor): a
+# closed loop through a FIFO that runs chunks of CHUNK_EPISODES exploring episodes, actor i
+# the chunks i, i + ACTORS, ... (chunk c explores the scenes of seed SEED * 100000 + c,
+# whichever actor runs it). sim-step starts chunk c once actors/gate-i/cccc.go exists and
+# writes actors/gate-i/cccc.steps when it has ended; qte-select takes up each new checkpoint at
+# the start of an episode; every finished episode is appended to `actor_replay` at once. Only
+# trajectories go back to sim-step, so a pipeline waiting at its gate holds nothing in flight.
 actor_replay=$run/replay.rec
 [ "$ROLE" != actor ] || actor_replay=$run/actors/replay-$ACTOR_INDEX.rec
-run_chunk() {  # CHUNK
-  local name fifo seed
-  name=$run/chunks/$(printf '%04d' "$1") seed=$((SEED * 100000 + $1))
-  fifo=$(mktemp -u); mkfifo "$fifo"
-  if ! sim-step --task "$task" --variation "$VARIATION" --episodes "$CHUNK_EPISODES" --seed "$seed" \
-      --scenes explore --image-size "$IMAGE" --compress < "$fifo" \
-    | qte-select --checkpoint "$run/ckpt/latest.rec" --reload --k "$ACT_K" $act_branching --epsilon "$EPSILON" \
-        --rotation-noise "$ROTATION_NOISE" --seed "$seed" --threads 1 2>> "$run/actor.log" \
-    | plan-path | tee "$fifo" "$name.partial" \
-    | keyframe --agent --seed "$SEED" --append --output "$actor_replay" 2>> "$run/actor.log"; then
-    rm -f "$fifo"
-    return 1
-  fi
-  rm -f "$fifo"
-  mv "$name.partial" "$name.rec"
+gate_dir() { echo "$run/actors/gate-$1"; }  # ACTOR
+chunk_done() { [ -f "$(gate_dir $(( $1 % ACTORS )))/$(printf '%04d' "$1").steps" ]; }  # CHUNK
+next_chunk() {  # ACTOR -> its first chunk not finished
+  local c=$1
+  while chunk_done "$c"; do c=$(( c + ACTORS )); done
+  echo "$c"
 }
-# Environment steps of the finished chunks (each counted once, into chunks/NNNN.steps; written
-# under a name of this process's own, since roles on other nodes count too).
-finished_steps() {
-  local f n=0
-  for f in "$run"/chunks/*.rec; do
-    [ -f "$f" ] || continue
-    if [ ! -f "${f%.rec}.steps" ]; then
-      stream-dump --summary "$f" | awk '$1 == "action" { print $2 }' > "${f%.rec}.steps.$$"
-      mv "${f%.rec}.steps.$$" "${f%.rec}.steps"
-    fi
-    n=$(( n + $(cat "${f%.rec}.steps") ))
+# Environment steps of the finished chunks.
+finished_steps() { { cat "$run"/actors/gate-*/[0-9]*.steps 2>/dev/null || true; } | awk '{ n += $1 } END { print n + 0 }'; }
+actor_programs=(sim-step qte-select plan-path tee keyframe)
+start_actor() {  # ACTOR: its pipeline, in the background, from its first chunk not finished
+  local i=$1 gate fifo
+  gate=$(gate_dir "$i") fifo=$run/actors/loop-$i
+  mkdir -p "$gate"
+  rm -f "$fifo" "$run/actors/status-$i"
+  mkfifo "$fifo"
+  (
+    set +e  # the status of every program is what this subshell is for
+    sim-step --task "$task" --variation "$VARIATION" --episodes 10000000 --seed $(( SEED * 100000 )) --scenes explore \
+        --chunk-episodes "$CHUNK_EPISODES" --first-chunk "$(next_chunk "$i")" --chunk-stride "$ACTORS" --gate "$gate" \
+        --image-size "$IMAGE" --compress < "$fifo" \
+      | qte-select --checkpoint "$run/ckpt/latest.rec" --reload --k "$ACT_K" $act_branching --epsilon "$EPSILON" \
+          --rotation-noise "$ROTATION_NOISE" --seed $(( SEED * 100000 + i )) --threads 1 \
+      | plan-path | tee >(stream-cat --type trajectory > "$fifo") \
+      | keyframe --agent --seed "$SEED" --append --output "$actor_replay"
+    echo "${PIPESTATUS[*]}" > "$run/actors/status-$i"
+  ) 2>> "$run/actor.log" &
+  actor_pids[$i]=$!
+}
+# An actor whose pipeline has ended while its chunk was running: which program failed, how.
+actor_failure() {  # ACTOR
+  local status=() k
+  read -r -a status < "$run/actors/status-$1" 2>/dev/null || { echo "its pipeline was killed"; return; }
+  for k in "${!status[@]}"; do
+    [ "${status[$k]}" = 0 ] || { echo "${actor_programs[$k]} $(describe_status "${status[$k]}")"; return; }
   done
-  echo "$n"
+  echo "its pipeline ended before the chunk did"
+}
+# Opens the chunks CHUNK... and waits until each has ended, watching the learner and the
+# actors: a dead learner stops the run; a dead actor is started again on its chunk (the
+# chunk's finished episodes stay in the replay), and a chunk that fails twice stops the run.
+declare -A failures=()
+run_round() {  # CHUNK...
+  local c i pending
+  for c in "$@"; do touch "$(gate_dir $(( c % ACTORS )))/$(printf '%04d' "$c").go"; done
+  while :; do
+    pending=0
+    for c in "$@"; do
+      chunk_done "$c" && continue
+      pending=1
+      i=$(( c % ACTORS ))
+      kill -0 "${actor_pids[$i]}" 2>/dev/null && continue
+      wait "${actor_pids[$i]}" 2>/dev/null || true
+      chunk_done "$c" && continue
+      failures[$c]=$(( ${failures[$c]:-0} + 1 ))
+      reaped_actor_ticks=$(( reaped_actor_ticks + ${actor_ticks[$i]:-0} )); actor_ticks[$i]=0
+      log "$task $LABEL seed $SEED: actor $i failed in chunk $c (attempt ${failures[$c]}): $(actor_failure "$i"); last line of $run/actor.log: $(grep -v '^ *[0-9]* Done ' "$run/actor.log" | tail -1)"
+      [ "${failures[$c]}" -lt 2 ] || { log "chunk $c failed twice: stopping"; exit 1; }
+      start_actor "$i"
+    done
+    [ "$pending" = 1 ] || return 0
+    check_learner
+    sleep 0.2
+  done
+}
+stop_actors() {  # at a chunk boundary: every actor ends its pipeline
+  local i
+  for i in "${!actor_pids[@]}"; do touch "$(gate_dir "$i")/stop"; done
+  for i in "${!actor_pids[@]}"; do wait "${actor_pids[$i]}" 2>/dev/null || true; done
 }
 
 # Actor i of a split run: chunks i, i + ACTORS, ... until the run has its environment steps or
-# the learner says it is done; each chunk that fails is tried once more.
+# the learner says it is done.
 if [ "$ROLE" = actor ]; then
   mkdir -p "$run/actors"
   until [ -f "$run/ckpt/latest.rec" ]; do sleep 2; done
-  chunk=$ACTOR_INDEX tries=0
+  rm -f "$(gate_dir "$ACTOR_INDEX")"/*.go "$(gate_dir "$ACTOR_INDEX")/stop"
+  trap 'kill_tree "${actor_pids[@]}"' EXIT
+  start_actor "$ACTOR_INDEX"
+  chunk=$(next_chunk "$ACTOR_INDEX")
   while [ ! -f "$run/actor.done" ] && [ "$(finished_steps)" -lt "$ENV_STEPS" ]; do
-    if [ -f "$run/chunks/$(printf '%04d' "$chunk").rec" ] || run_chunk "$chunk"; then
-      chunk=$((chunk + ACTORS)) tries=0
-    else
-      tries=$((tries + 1))
-      log "$task $LABEL seed $SEED: actor $ACTOR_INDEX: chunk $chunk failed (attempt $tries)"
-      [ "$tries" -lt 2 ] || exit 1
-    fi
+    run_round "$chunk"
+    chunk=$(( chunk + ACTORS ))
   done
+  stop_actors
+  trap - EXIT
   log "$task $LABEL seed $SEED: actor $ACTOR_INDEX done"
   exit 0
 fi
@@ -137,10 +233,12 @@ fi
 # 1. Demonstrations -> transitions (once; written under a temporary name, then renamed).
 if [ ! -f "$run/replay.rec" ]; then
   log "$task: $DEMOS demonstrations"
+  before=$(shell_ticks)
   demo-record --task "$task" --episodes "$DEMOS" --seed "$SEED" --scenes demo --variation "$VARIATION" --image-size "$IMAGE" \
     --compress --output "$run/demos.rec" 2>> "$run/demos.log"
   keyframe --seed "$SEED" --output "$run/replay.rec.tmp" "$run/demos.rec" 2>> "$run/demos.log"
   mv "$run/replay.rec.tmp" "$run/replay.rec"
+  demos_ticks=$(( $(shell_ticks) - before ))
 fi
 
 # 2. The learner, in the background for the whole run; with ROLE=learner it follows the
@@ -156,16 +254,22 @@ qattn-train --follow --resume --stop-file "$run/actor.done" --replay-ratio "$RAT
   --architecture "$ARCH" --batch "$BATCH" --tree-target "$TARGET_K" $target_branching --n-step "$N_STEP" --seed "$SEED" --threads "$LEARNER_THREADS" \
   --checkpoint-dir "$run/ckpt" --metrics "$run/train.csv" "${inputs[@]}" 2>> "$run/train.log" &
 learner=$!
-trap 'kill $(jobs -p) 2>/dev/null || true' EXIT  # the learner and any actor still running
-while [ ! -f "$run/ckpt/latest.rec" ]; do kill -0 $learner || { tail -2 "$run/train.log"; exit 1; }; sleep 0.5; done
+trap 'kill_tree $(jobs -p)' EXIT  # the learner and the actors, with every program they started
+while [ ! -f "$run/ckpt/latest.rec" ]; do check_learner; sleep 0.5; done
 
 # The learner's newest step, from its checkpoint names.
 learner_step() { ls "$run/ckpt" | sed -n 's/^step-0*\([0-9][0-9]*\)\.rec$/\1/p' | sort -n | tail -1; }
+pretraining=$(( $(learner_step) < PRETRAIN ))  # pretraining happens in this process tree
 # Waits until the learner has taken the steps the replay ratio allows for `agent` transitions.
+# The gradient steps the replay ratio allows after N agent transitions: what
+# `qattn-train --steps-allowed N` prints (a test holds the two equal), without the second it
+# takes LibTorch to start, once per chunk.
+steps_allowed() { awk -v n="$1" -v p="$PRETRAIN" -v r="$RATIO" 'BEGIN { printf "%d\n", p + int(r * n) }'; }
 wait_for_learner() {
-  local want; want=$(qattn-train --steps-allowed "$1" --pretrain "$PRETRAIN" --replay-ratio "$RATIO")
+  local want; want=$(steps_allowed "$1")
   want=$(( want / CHECKPOINT_EVERY * CHECKPOINT_EVERY ))
-  while [ "$(learner_step)" -lt "$want" ]; do kill -0 $learner || { tail -2 "$run/train.log"; exit 1; }; sleep 1; done
+  while [ "$(learner_step)" -lt "$want" ]; do check_learner; sleep 0.5; done
+  if [ "$pretraining" = 1 ]; then pretrain_ticks=$(stat_ticks "$learner" 14 15) pretraining=0; fi
 }
 # Greedy episodes of one checkpoint on the held-out seeds -> one CSV row.
 # eval_point: the budget the evaluation stands for (0, EVAL_EVERY, ..., ENV_STEPS); env_steps
@@ -177,13 +281,16 @@ evaluate() {  # CHECKPOINT ENV_STEPS OUT.csv LEARNER_STEP EVAL_POINT
     | qte-select --checkpoint "$1" --k "$ACT_K" $act_branching --threads 1 \
     | plan-path | tee "$fifo" \
     | episode-stats --label "$LABEL" --column seed="$SEED" --column env_steps="$2" --column train_step="$4" \
-        --column eval_point="$5" --column train_s="$(cat "$run/train_seconds")" --column cpu_s="$(cat "$run/cpu_seconds")" \
+        --column eval_point="$5" --column train_s="$(cat "$run/train_seconds")" $(cpu_columns) \
         > "$3.tmp"
   rm -f "$fifo"
   mv "$3.tmp" "$3"
 }
 
-declare -A failures=()
+# The actors, waiting at their gates (stale gates of an interrupted run removed).
+mkdir -p "$run/actors"
+rm -f "$run"/actors/gate-*/*.go "$run"/actors/gate-*/stop
+if [ "$ROLE" = all ]; then for ((i = 0; i < ACTORS; i++)); do start_actor "$i"; done; fi
 while :; do
   env_steps=$(finished_steps)
   finished=0
@@ -199,33 +306,29 @@ while :; do
     count_training_time
     # eval_point: the budget the evaluation stands for; out of budget, the steps it bought.
     point=$(( finished == 2 ? env_steps : finished ? ENV_STEPS : mark * EVAL_EVERY ))
-    before=$(stat_ticks $$ 16 17)
+    before=$(shell_ticks)
     evaluate "$snapshot" "$env_steps" "$eval_csv" "$step" "$point"
-    eval_ticks=$(( eval_ticks + $(stat_ticks $$ 16 17) - before ))
+    eval_ticks=$(( eval_ticks + $(shell_ticks) - before ))
     clock=$(date +%s)
     log "$task $LABEL seed $SEED: env steps $env_steps, learner step $step: $(tail -1 "$eval_csv")"
   fi
   [ "$finished" = 0 ] || break
   # A split run's learner: the actors (elsewhere) add chunks; look again in a while.
-  if [ "$ROLE" = learner ]; then sleep 5; continue; fi
+  if [ "$ROLE" = learner ]; then check_learner; sleep 5; continue; fi
 
-  # One round: the next ACTORS chunks not yet finished, side by side.
-  round=() chunk=0
-  while [ "${#round[@]}" -lt "$ACTORS" ]; do
-    [ -f "$run/chunks/$(printf '%04d' "$chunk").rec" ] || round+=("$chunk")
-    chunk=$((chunk + 1))
-  done
-  pids=()
-  for c in "${round[@]}"; do run_chunk "$c" & pids+=($!); done
-  for i in "${!round[@]}"; do
-    c=${round[$i]}
-    if ! wait "${pids[$i]}"; then
-      failures[$c]=$(( ${failures[$c]:-0} + 1 ))
-      log "$task $LABEL seed $SEED: the actor of chunk $c failed (attempt ${failures[$c]}); its finished episodes stay in the replay"
-      [ "${failures[$c]}" -lt 2 ] || { log "chunk $c failed twice: stopping"; exit 1; }
-    fi
-  done
+  # Under a budget, the actor is paced by the learner (see out_of_budget).
+  if [ "$CPU_BUDGET" -gt 0 ]; then
+    wait_for_learner "$env_steps"
+    if out_of_budget; then continue; fi
+  fi
+  # One round: the chunks of the lowest round not finished, side by side.
+  first=0
+  while chunk_done "$first"; do first=$(( first + 1 )); done
+  round=()
+  for ((c = first / ACTORS * ACTORS; c < (first / ACTORS + 1) * ACTORS; c++)); do chunk_done "$c" || round+=("$c"); done
+  run_round "${round[@]}"
 done
+stop_actors
 touch "$run/actor.done"
 # Out of budget: the learner would go on to the steps the replay allows, past the budget and
 # never evaluated; stop it (its checkpoints are whole files, written under temporary names).

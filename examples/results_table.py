@@ -6,6 +6,7 @@
     results_table.py --curves --task TASK RUN.csv...
     results_table.py --failures FAILURES.csv...
     results_table.py --lookalikes FAILURES.csv...
+    results_table.py --paired BASELINE [--markdown] RUN.csv...
 
 One row per task and label (method): the runs' final evaluations (the last eval_point of each run):
 the environment and learner steps they had taken (means), their success's mean and sample
@@ -21,10 +22,16 @@ tasks; --curves every evaluation of TASK's runs, with the task, for a picture of
 runs' failure_reasons CSVs (results/<takeaway>/failures/, named the same way) into one with the
 task as first column; --lookalikes sums them per task and label: of the episodes that went for an
 object (success, target or distractor), the share that went for the right one (success or
-target), to set beside the chance of picking among the task's lookalikes. Standard library only.
+target), to set beside the chance of picking among the task's lookalikes. --paired BASELINE
+compares every other label with the label BASELINE, paired by seed (the seeds both have): the
+mean difference in final success, its 95% interval (Student's t over the paired differences),
+and the two-sided p-value of the exact sign-flip permutation test (all 2^n sign assignments of
+the n differences; the test makes no assumption about their distribution). Standard library only.
 """
 import argparse
 import csv
+import itertools
+import math
 import os
 import re
 import statistics
@@ -120,6 +127,79 @@ def summary(task, label, rows):
     }
 
 
+def t_quantile(p, df):
+    """The p-quantile of Student's t with df degrees of freedom (numerical: the density
+    integrated by Simpson's rule, the quantile found by bisection)."""
+    log_c = math.lgamma((df + 1) / 2) - math.lgamma(df / 2) - 0.5 * math.log(df * math.pi)
+
+    def cdf(x):  # P(T <= x) for x >= 0
+        n = 2000
+        h = x / n
+        f = [math.exp(log_c - (df + 1) / 2 * math.log1p((i * h) ** 2 / df)) for i in range(n + 1)]
+        return 0.5 + h / 3 * (f[0] + f[-1] + 4 * sum(f[1:-1:2]) + 2 * sum(f[2:-1:2]))
+
+    low, high = 0.0, 1.0
+    while cdf(high) < p:
+        high *= 2
+    for _ in range(60):
+        mid = (low + high) / 2
+        low, high = (mid, high) if cdf(mid) < p else (low, mid)
+    return (low + high) / 2
+
+
+def sign_flip_p(differences):
+    """Two-sided p-value of the exact sign-flip permutation test of a zero mean difference."""
+    observed = abs(sum(differences))
+    count = 0
+    for signs in itertools.product((1, -1), repeat=len(differences)):
+        count += abs(sum(s * d for s, d in zip(signs, differences))) >= observed - 1e-12
+    return count / 2 ** len(differences)
+
+
+def paired(runs, baseline):
+    """Each label against `baseline` on the same task, paired by seed."""
+    table = []
+    for (task, label), rows in sorted(runs.items()):
+        base = {r["seed"]: r for r in runs.get((task, baseline), [])}
+        if label == baseline or not base:
+            continue
+        pairs = [(r, base[r["seed"]]) for r in sorted(rows, key=lambda r: int(r["seed"])) if r["seed"] in base]
+        if not pairs:
+            continue
+        d = [float(a["success_rate"]) - float(b["success_rate"]) for a, b in pairs]
+        mean = statistics.mean(d)
+        half = t_quantile(0.975, len(d) - 1) * statistics.stdev(d) / math.sqrt(len(d)) if len(d) > 1 else float("nan")
+        table.append({
+            "task": task,
+            "label": label,
+            "baseline": baseline,
+            "pairs": len(d),
+            "mean_success": f"{statistics.mean(float(a['success_rate']) for a, _ in pairs):.3f}",
+            "baseline_mean_success": f"{statistics.mean(float(b['success_rate']) for _, b in pairs):.3f}",
+            "mean_difference": f"{mean:+.3f}",
+            "ci95_low": f"{mean - half:+.3f}",
+            "ci95_high": f"{mean + half:+.3f}",
+            "sign_flip_p": f"{sign_flip_p(d):.4f}",
+            "per_seed": " ".join(f"s{a['seed']}:{x:+.2f}" for (a, _), x in zip(pairs, d)),
+        })
+    return table
+
+
+def print_table(table, markdown):
+    if not table:
+        return
+    columns = list(table[0].keys())
+    if markdown:
+        print("| " + " | ".join(columns) + " |")
+        print("|" + "---|" * len(columns))
+        for row in table:
+            print("| " + " | ".join(str(row[c]) for c in columns) + " |")
+    else:
+        writer = csv.DictWriter(sys.stdout, fieldnames=columns, lineterminator="\n")
+        writer.writeheader()
+        writer.writerows(table)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--markdown", action="store_true", help="a Markdown table instead of CSV")
@@ -131,6 +211,7 @@ def main():
     parser.add_argument("--tasks", action="store_true", help="the runs' tasks, one a line")
     parser.add_argument("--curves", action="store_true", help="every evaluation of --task's runs, as CSV")
     parser.add_argument("--task", help="the task of --curves")
+    parser.add_argument("--paired", metavar="BASELINE", help="every other label against BASELINE, paired by seed")
     parser.add_argument("runs", nargs="+")
     args = parser.parse_args()
     if args.failures:
@@ -161,17 +242,10 @@ def main():
         writer.writeheader()
         writer.writerows(rows)
         return
-    table = [summary(task, label, rows) for (task, label), rows in sorted(runs.items())]
-    columns = list(table[0].keys())
-    if args.markdown:
-        print("| " + " | ".join(columns) + " |")
-        print("|" + "---|" * len(columns))
-        for row in table:
-            print("| " + " | ".join(str(row[c]) for c in columns) + " |")
-    else:
-        writer = csv.DictWriter(sys.stdout, fieldnames=columns, lineterminator="\n")
-        writer.writeheader()
-        writer.writerows(table)
+    if args.paired:
+        print_table(paired(runs, args.paired), args.markdown)
+        return
+    print_table([summary(task, label, rows) for (task, label), rows in sorted(runs.items())], args.markdown)
 
 
 if __name__ == "__main__":

@@ -44,6 +44,12 @@ static cli::Usage usage() {
                          "(full demonstrations)", ""},
       {"no-points", "", "leave the world-frame point clouds out of observations", ""},
       {"threads", "N", "rendering threads", "2"},
+      {"chunk-episodes", "N", "with --task: run episodes in chunks of N, chunk c drawn as --seed S + c "
+                              "would draw them (an actor that stays up for a whole learning run); needs --gate", "0"},
+      {"first-chunk", "C", "the first chunk this process runs", "0"},
+      {"chunk-stride", "S", "the chunks this process runs: C, C + S, C + 2S, ...", "1"},
+      {"gate", "DIR", "chunk c starts once DIR/cccc.go exists (c with at least four digits); none starts "
+                      "once DIR/stop exists; DIR/cccc.steps gets the environment steps of chunk c when it ends", ""},
   };
   u.options.push_back(cli::output_file());
   u.add_options(sim_step::episode_options(1, sim_step::SceneSet::any));
@@ -54,6 +60,8 @@ static cli::Usage usage() {
        "one reset, its first front image saved as PNG"},
       {"sim-step --task pick_and_lift --episodes 100 < fifo | qte-select --checkpoint ckpt/latest.rec | plan-path > fifo",
        "an actor: the learning loop closed by a FIFO"},
+      {"sim-step --task reach_target --episodes 1000000 --chunk-episodes 10 --gate gate --scenes explore < fifo | ...",
+       "an actor paced by its learning loop: touch gate/0000.go, gate/0001.go, ... to start each chunk, gate/stop to end"},
       {"stream-pack reset task=lift_numbered_block variation:i32=1 seed:i64=5 | sim-step --image-size 256x256",
        "one explicit reset, 256x256 images"},
   };
@@ -74,7 +82,16 @@ static void run(const cli::Arguments& args) {
   const std::string input = args.input();
   std::unique_ptr<stream::RecordReader> reader;
   stream::RecordWriter writer(args.text("output"));
-  sim_step::SimStep stage(simulator, plan);
+  const int chunk_episodes = static_cast<int>(args.integer("chunk-episodes", 0, 10000000));
+  if (chunk_episodes > 0 && (!plan || args.text("gate").empty()))
+    throw UsageError("--chunk-episodes needs --task and --gate");
+  sim_step::DirectoryGate gate(args.text("gate"));
+  sim_step::SimStep stage = chunk_episodes > 0
+                                ? sim_step::SimStep(simulator, *plan,
+                                                    {chunk_episodes, static_cast<int>(args.integer("first-chunk", 0, 100000000)),
+                                                     static_cast<int>(args.integer("chunk-stride", 1, 1000000))},
+                                                    gate)
+                                : sim_step::SimStep(simulator, plan);
   stream::run_stage(
       stage,
       [&]() -> std::optional<stream::Record> {

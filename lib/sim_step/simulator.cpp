@@ -1,9 +1,14 @@
 #include "sim_step/simulator.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <sstream>
+#include <thread>
 
+#include "common/atomic_file.hpp"
 #include "common/error.hpp"
 #include "common/random.hpp"
 #include "robot/joint_path.hpp"
@@ -261,8 +266,57 @@ void SimStep::handle(const stream::Record& record, const stream::Emit& emit) {
 }
 
 void SimStep::start_episodes_due(const stream::Emit& emit) {
-  while (plan_ && simulator_.episode_over() && started_ < plan_->episodes)
-    simulator_.handle(plan_reset(*plan_, started_++), emit);
+  if (!plan_ || !simulator_.episode_over()) return;
+  if (!chunks_) {
+    while (simulator_.episode_over() && started_ < plan_->episodes)
+      simulator_.handle(plan_reset(*plan_, started_++), emit);
+    return;
+  }
+  count_ended_episode();
+  while (simulator_.episode_over() && !stopped_ && started_ < plan_->episodes) {
+    const int index = started_ % chunks_->episodes;
+    const int chunk = chunks_->chunk_of(started_);
+    if (index == 0 && !gate_->open(chunk)) {
+      stopped_ = true;
+      return;
+    }
+    EpisodePlan chunk_plan = *plan_;
+    chunk_plan.seed = plan_->seed + static_cast<uint64_t>(chunk);
+    started_ += 1;
+    simulator_.handle(plan_reset(chunk_plan, index), emit);
+    count_ended_episode();  // an episode can end at its reset (a scene already solved)
+  }
+}
+
+void SimStep::count_ended_episode() {
+  if (ended_ == started_ || !simulator_.episode_over()) return;  // none has ended since the last count
+  chunk_steps_ += simulator_.steps();
+  ended_ += 1;
+  if (ended_ % chunks_->episodes == 0 || ended_ == plan_->episodes) {
+    gate_->finished(chunks_->chunk_of(ended_ - 1), chunk_steps_);
+    chunk_steps_ = 0;
+  }
+}
+
+std::string DirectoryGate::path(int chunk, const std::string& suffix) const {
+  char name[32];
+  std::snprintf(name, sizeof name, "%04d.%s", chunk, suffix.c_str());
+  return (std::filesystem::path(directory_) / name).string();
+}
+
+bool DirectoryGate::open(int chunk) {
+  const std::filesystem::path stop = std::filesystem::path(directory_) / "stop";
+  const std::string go = path(chunk, "go");
+  for (;;) {  // a file test every 20 ms costs nothing beside an episode
+    if (std::filesystem::exists(stop)) return false;
+    if (std::filesystem::exists(go)) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
+void DirectoryGate::finished(int chunk, int steps) {
+  const std::string text = std::to_string(steps) + "\n";
+  write_file_atomically(path(chunk, "steps"), text.data(), text.size());
 }
 
 }  // namespace qte::sim_step

@@ -56,6 +56,7 @@ class Simulator : public stream::Stage {
   void handle(const stream::Record& record, const stream::Emit& emit) override;
 
   bool episode_over() const { return terminal_; }
+  int steps() const { return step_; }  // next-best poses executed in the current episode
 
   // For tests and tools that drive the world directly.
   world::World* world() { return world_.get(); }
@@ -94,6 +95,39 @@ const char* scene_set_name(SceneSet set);
 uint64_t scene_seed(uint64_t run_seed, SceneSet set, uint64_t episode);
 inline SceneSet scene_set_of(uint64_t scene_seed) { return static_cast<SceneSet>(scene_seed % 4); }
 
+// A run's exploration in chunks, for an actor that stays up for the whole run: chunk c holds
+// `episodes` episodes drawn as the plan with seed `plan.seed + c` draws them, so a chunk's
+// scenes do not depend on which process runs it; an actor runs chunks first, first + stride, ...
+struct ChunkPlan {
+  int episodes = 10;
+  int first = 0;
+  int stride = 1;
+  int chunk_of(int episode) const { return first + episode / episodes * stride; }
+};
+
+// Decides when each chunk starts and hears when it has ended: the learning loop paces an
+// actor by its learner through it.
+class ChunkGate {
+ public:
+  virtual ~ChunkGate() = default;
+  virtual bool open(int chunk) = 0;  // blocks until `chunk` may start; false: no more chunks
+  virtual void finished(int chunk, int steps) = 0;
+};
+
+// The gate as files, for shell scripts: chunk c starts once DIR/cccc.go exists (c printed
+// with at least four digits), no chunk starts once DIR/stop exists, and when a chunk's last
+// episode has ended DIR/cccc.steps holds its environment steps (written atomically).
+class DirectoryGate : public ChunkGate {
+ public:
+  explicit DirectoryGate(std::string directory) : directory_(std::move(directory)) {}
+  bool open(int chunk) override;
+  void finished(int chunk, int steps) override;
+  std::string path(int chunk, const std::string& suffix) const;
+
+ private:
+  std::string directory_;
+};
+
 // What sim-step runs by itself: episodes of one task, each reset from its own seed.
 struct EpisodePlan {
   std::string task;
@@ -114,15 +148,26 @@ stream::Record plan_reset(const EpisodePlan& plan, int index);
 class SimStep : public stream::Stage {
  public:
   SimStep(Simulator& simulator, std::optional<EpisodePlan> plan) : simulator_(simulator), plan_(std::move(plan)) {}
+  // In chunks: `gate` opens each chunk and hears of its end (it must outlive the stage).
+  SimStep(Simulator& simulator, EpisodePlan plan, ChunkPlan chunks, ChunkGate& gate)
+      : simulator_(simulator), plan_(std::move(plan)), chunks_(chunks), gate_(&gate) {}
   void start(const stream::Emit& emit) override;
   void handle(const stream::Record& record, const stream::Emit& emit) override;
-  bool done() const override { return plan_ && simulator_.episode_over() && started_ >= plan_->episodes; }
+  bool done() const override {
+    return plan_ && simulator_.episode_over() && (started_ >= plan_->episodes || stopped_);
+  }
 
  private:
   void start_episodes_due(const stream::Emit& emit);
+  void count_ended_episode();
   Simulator& simulator_;
   std::optional<EpisodePlan> plan_;
+  std::optional<ChunkPlan> chunks_;
+  ChunkGate* gate_ = nullptr;
   int started_ = 0;
+  int ended_ = 0;        // episodes of the plan that have ended
+  int chunk_steps_ = 0;  // environment steps of the current chunk so far
+  bool stopped_ = false;  // the gate said no more chunks
 };
 
 }  // namespace qte::sim_step

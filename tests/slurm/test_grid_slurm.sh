@@ -25,10 +25,10 @@ make -C "$examples" --no-print-directory split SCHEDULER=slurm TASK=reach_target
 # checkpoints written, the run not done. Slurm kills it and starts it again; it resumes.
 run0=$tmp/grid/reach_target/c2farm-k1-t0-seed0
 for _ in $(seq 1 600); do
-  [ -f "$run0/chunks/0000.rec" ] && break
+  [ -f "$run0/actors/gate-0/0000.steps" ] && break
   sleep 0.5
 done
-[ -f "$run0/chunks/0000.rec" ] || fail "task 0 never finished a chunk: $(squeue; tail -3 "$tmp"/grid/slurm-*_0.out)"
+[ -f "$run0/actors/gate-0/0000.steps" ] || fail "task 0 never finished a chunk: $(squeue; tail -3 "$tmp"/grid/slurm-*_0.out)"
 [ ! -f "$run0/eval.csv" ] || fail "task 0 finished before it could be requeued"
 learner_steps() { grep -E '^[0-9]' "$run0/train.csv" | cut -d, -f1; }
 before=$(learner_steps | tail -n 1)
@@ -58,7 +58,7 @@ steps=$(learner_steps)
 requeued=$(scontrol show job "${array}_0" 2>/dev/null | sed -n 's/.*Restarts=\([0-9]*\).*/\1/p')
 [ "${requeued:-0}" -ge 1 ] || fail "task 0 was not restarted (Restarts=${requeued:-?})"
 count() { stream-dump --summary | awk '$1 == "transition" { print $2 }'; }
-actions=$(cat "$run0"/chunks/*.steps | awk '{ n += $1 } END { print n }')
+actions=$(cat "$run0"/actors/gate-*/*.steps | awk '{ n += $1 } END { print n }')
 agent=$(( $(count < "$run0/replay.rec") - $(stream-cat --type transition --where demo=1 "$run0/replay.rec" | count) ))
 [ "$agent" -ge "$actions" ] || fail "requeued run: $agent agent transitions for $actions actions"
 
@@ -68,6 +68,6 @@ split=$tmp/split/reach_target/c2farm-k1-t0-seed1
 for i in 0 1; do
   [ -s "$split/actors/replay-$i.rec" ] || fail "actor $i wrote no episodes"
 done
-[ -f "$split/chunks/0000.rec" ] && [ -f "$split/chunks/0001.rec" ] || fail "chunks: $(ls "$split/chunks")"
+[ -f "$split/actors/gate-0/0000.steps" ] && [ -f "$split/actors/gate-1/0001.steps" ] || fail "chunks: $(ls "$split"/actors/gate-*)"
 grep -q "actor 1 done" "$tmp"/split/slurm-*_1.out || fail "actor 1 did not finish: $(cat "$tmp"/split/slurm-*_1.out)"
 echo "ok: grid (array $array, task 0 restarted $requeued time(s), $actions actions, $agent agent transitions), split run"

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# examples/learn.sh with ACTORS=2: one learner, two actor pipelines side by side on chunks
-# with disjoint seeds; one actor killed mid-chunk costs only its chunk, which runs again, and
-# the run completes with every chunk and every episode accounted for.
+# examples/learn.sh with ACTORS=2: one learner, two actor pipelines side by side on their
+# chunks (scenes per chunk: tests/unit/sim_step); one actor killed mid-chunk costs only its
+# chunk, which runs again in a new pipeline, and the run completes with every chunk and every
+# episode accounted for.
 source "$(dirname "$0")/common.sh"
 learn=${QTE_SOURCE:?}/examples/learn.sh
 run=$tmp/run
@@ -10,34 +11,35 @@ export SEED=0 DEMOS=2 IMAGE=48x48 ACT_K=1 TARGET_K=0 ENV_STEPS=30 CHUNK_EPISODES
 
 bash "$learn" reach_target "$run" 2> "$tmp/learn.log" &
 learn_pid=$!
-# Chunk 1 explores the scenes of seed 1: kill its simulator as soon as it runs, and meanwhile
+# Actor 1 runs chunks 1, 3, ...: kill its simulator once chunk 1 has started, and meanwhile
 # check that learn.sh never runs more than one learner (its children only: LeakSanitizer's
 # tracer, a child of the learner with its command line, shows up under make sanitize).
 killed=0 learners=0
 for _ in $(seq 1 2400); do
   now=$(pgrep -c -P $learn_pid -f "qattn-train --follow .*$run/replay.rec" || true)
   learners=$(( now > learners ? now : learners ))
-  if [ $killed = 0 ] && pkill -9 -f "sim-step --task reach_target .*--seed 1 --scenes explore"; then killed=1; fi
+  if [ $killed = 0 ] && [ -f "$run/actors/gate-1/0001.go" ] && pkill -9 -f "sim-step --task reach_target .*--first-chunk 1 --chunk-stride 2"; then
+    killed=1
+  fi
   kill -0 $learn_pid 2>/dev/null || break
   sleep 0.05
 done
 wait $learn_pid || fail "learn.sh with ACTORS=2: exit $?: $(tail -5 "$tmp/learn.log")"
 [ $killed = 1 ] || fail "chunk 1's actor never ran"
 [ "$learners" = 1 ] || fail "$learners learners at once"
-grep -q "the actor of chunk 1 failed (attempt 1)" "$tmp/learn.log" || fail "no failed chunk: $(cat "$tmp/learn.log")"
+grep -q "actor 1 failed in chunk 1 (attempt 1): sim-step killed by signal KILL" "$tmp/learn.log" \
+  || fail "no failed chunk: $(cat "$tmp/learn.log")"
 [ -f "$run/eval.csv" ] || fail "no eval.csv"
 
-# Every chunk finished, each with its episodes, from seeds no other chunk used.
-chunks=$(ls "$run/chunks" | grep -c '\.rec$')
+# Every chunk up to the last finished, each actor's own.
+chunks=$(ls "$run"/actors/gate-*/ | grep -c '\.steps$')
 [ "$chunks" -ge 2 ] || fail "$chunks chunks"
-[ -z "$(ls "$run/chunks" | grep partial)" ] || fail "partial chunks left: $(ls "$run/chunks")"
-seeds=$(for f in "$run"/chunks/*.rec; do
-  stream-cat --type obs --where frame=0 "$f" | stream-dump | awk '$1 == "episode_seed" { print $4 }'; done)
-[ "$(wc -l <<<"$seeds")" = $((chunks * CHUNK_EPISODES)) ] || fail "episodes: $seeds"
-[ "$(sort -u <<<"$seeds" | wc -l)" = $((chunks * CHUNK_EPISODES)) ] || fail "seeds repeat across chunks: $seeds"
+for ((c = 0; c < chunks; c++)); do
+  [ -f "$run/actors/gate-$((c % 2))/$(printf '%04d' $c).steps" ] || fail "chunk $c missing: $(ls "$run"/actors/gate-*)"
+done
 # Nothing lost: the replay holds a transition for every action of every finished chunk (and
 # those of the killed attempt's finished episodes besides).
-actions=$(cat "$run"/chunks/*.steps | awk '{ n += $1 } END { print n }')
+actions=$(cat "$run"/actors/gate-*/*.steps | awk '{ n += $1 } END { print n }')
 count() { stream-dump --summary | awk '$1 == "transition" { print $2 }'; }
 agent=$(( $(count < "$run/replay.rec") - $(stream-cat --type transition --where demo=1 "$run/replay.rec" | count) ))
 [ "$agent" -ge "$actions" ] || fail "$agent agent transitions in the replay for $actions actions"

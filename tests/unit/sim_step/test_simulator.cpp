@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <fstream>
 #include <set>
 
 #include "common/random.hpp"
@@ -319,4 +320,57 @@ TEST(SimStep, WithoutAPlanTheInputDrivesEverything) {
   EXPECT_EQ(next, in.size());
   ASSERT_EQ(out.size(), 2u);  // one observation per reset; other records produce nothing
   EXPECT_FALSE(stage.done());
+}
+
+// In chunks: chunk c's episodes are those of the plan seeded seed + c, the stride picks this
+// actor's chunks, the gate is asked before each chunk (and ends the stage when it says no),
+// and it hears each chunk's environment steps once its last episode has ended.
+TEST(SimStep, ChunksDrawTheirScenesFromTheirOwnSeedAndReportTheirSteps) {
+  struct RecordingGate : ChunkGate {
+    std::vector<int> opened;
+    std::vector<std::pair<int, int>> finished_chunks;
+    bool open(int chunk) override {
+      opened.push_back(chunk);
+      return opened.size() <= 2;  // two chunks, then no more
+    }
+    void finished(int chunk, int steps) override { finished_chunks.emplace_back(chunk, steps); }
+  } gate;
+  Simulator simulator(xarm(), small_options());
+  const EpisodePlan plan{"reach_target", 0, 1000, 100};
+  SimStep stage(simulator, plan, ChunkPlan{3, 1, 2}, gate);  // chunks 1, 3, 5, ... of 3 episodes
+  std::vector<stream::Record> out;
+  stream::run_stage(
+      stage,
+      [&]() -> std::optional<stream::Record> {  // a failing action: each episode is one step
+        return test_support::straight_trajectory(xarm(), robot::JointVector::Zero(), robot::JointVector::Ones(), true);
+      },
+      [&](const stream::Record& obs) { out.push_back(obs); });
+  EXPECT_TRUE(stage.done());
+  EXPECT_EQ(gate.opened, (std::vector<int>{1, 3, 5}));
+  EXPECT_EQ(gate.finished_chunks, (std::vector<std::pair<int, int>>{{1, 3}, {3, 3}}));
+  ASSERT_EQ(out.size(), 12u);  // 2 chunks x 3 episodes x (reset + terminal observation)
+  for (int chunk : {0, 1})
+    for (int episode = 0; episode < 3; ++episode) {
+      EpisodePlan chunk_plan = plan;
+      chunk_plan.seed = plan.seed + (chunk == 0 ? 1 : 3);
+      EXPECT_EQ(out[2 * (3 * chunk + episode)].scalar<int64_t>("episode_seed"),
+                plan_reset(chunk_plan, episode).scalar<int64_t>("seed"))
+          << "chunk " << chunk << " episode " << episode;
+    }
+}
+
+// The gate of the learning loop's shell script: files in a directory.
+TEST(SimStep, DirectoryGateOpensOnGoFilesStopsOnStopAndWritesSteps) {
+  const std::string dir = test_support::temp_dir("gate");
+  DirectoryGate gate(dir);
+  EXPECT_EQ(gate.path(7, "go"), dir + "/0007.go");
+  std::ofstream(gate.path(7, "go")).put('\n');
+  EXPECT_TRUE(gate.open(7));
+  gate.finished(7, 42);
+  std::ifstream steps(gate.path(7, "steps"));
+  int n = 0;
+  steps >> n;
+  EXPECT_EQ(n, 42);
+  std::ofstream(dir + "/stop").put('\n');
+  EXPECT_FALSE(gate.open(8));
 }

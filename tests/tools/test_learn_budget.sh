@@ -1,0 +1,66 @@
+#!/usr/bin/env bash
+# examples/learn.sh under a CPU budget: the actor is paced by the learner (the learner steps a
+# run has taken follow from its environment steps and the replay ratio, whatever the machine's
+# load), one actor pipeline (one qte-select, one LibTorch start) serves the whole run, the CSV
+# splits the processor time by role, and a learner that dies stops the run at once with a line
+# naming it; the run then resumes to its end.
+source "$(dirname "$0")/common.sh"
+learn=${QTE_SOURCE:?}/examples/learn.sh
+run=$tmp/run
+# A learner 3 steps per agent transition: without pacing, the actor runs ahead of it.
+export SEED=0 DEMOS=2 IMAGE=48x48 ACT_K=1 TARGET_K=0 ENV_STEPS=1000000 CHUNK_EPISODES=2 EVAL_EVERY=1000000 \
+  EVAL_EPISODES=1 BATCH=4 PRETRAIN=2 RATIO=3 CHECKPOINT_EVERY=1 START_AFTER=0 CPU_BUDGET=1000000
+
+# 0. learn.sh's pacing counts the steps allowed as qattn-train does.
+eval "$(sed -n '/^steps_allowed() {/p' "$learn")"
+for case in "0 200 0.5" "7 200 0.5" "3343 200 0.1" "1001 0 0.3" "45 2 3" "999999 100 0.7"; do
+  read -r n PRETRAIN RATIO <<<"$case"
+  [ "$(steps_allowed "$n")" = "$(qattn-train --steps-allowed "$n" --pretrain "$PRETRAIN" --replay-ratio "$RATIO")" ] \
+    || fail "steps allowed after $n transitions (pretrain $PRETRAIN, ratio $RATIO): learn.sh $(steps_allowed "$n")"
+done
+export PRETRAIN=2 RATIO=3
+
+# 1. Kill the learner once two chunks have ended: the run stops at once, naming it.
+bash "$learn" reach_target "$run" 2> "$tmp/learn.log" &
+learn_pid=$!
+actors=()
+for _ in $(seq 1 3000); do
+  actors+=($(pgrep -f "qte-select --checkpoint $run/ckpt/latest.rec" || true))
+  [ "$(ls "$run"/actors/gate-0/*.steps 2>/dev/null | wc -l)" -ge 2 ] && break
+  kill -0 $learn_pid 2>/dev/null || fail "learn.sh ended early: $(tail -5 "$tmp/learn.log")"
+  sleep 0.1
+done
+learner=$(pgrep -f "qattn-train --follow .*$run/replay.rec") || fail "no learner"
+kill -9 "$learner"
+for _ in $(seq 1 300); do kill -0 $learn_pid 2>/dev/null || break; sleep 0.1; done
+kill -0 $learn_pid 2>/dev/null && fail "learn.sh still running 30 s after its learner died"
+wait $learn_pid && fail "learn.sh exited 0 after its learner died"
+grep -q "the learner (qattn-train, pid $learner) died, killed by signal KILL; last line of $run/train.log: " "$tmp/learn.log" \
+  || fail "no line naming the dead learner: $(cat "$tmp/learn.log")"
+[ "$(sort -u <<<"${actors[*]// /$'\n'}" | grep -c .)" = 1 ] || fail "qte-select processes: ${actors[*]}"
+sleep 1
+pgrep -f "$run" > /dev/null && fail "programs of the run still running: $(pgrep -af "$run")"
+
+# 2. Resume with a budget this run has nearly spent: it ends by itself, with an evaluation.
+spent=$(awk -v t="$(getconf CLK_TCK)" '{ print int(($1 + $2 + $3 + $4 + $5) / t) }' "$run/cpu_ticks")
+CPU_BUDGET=$(( spent + 3 )) bash "$learn" reach_target "$run" 2> "$tmp/resume.log" \
+  || fail "the resumed run failed: $(tail -5 "$tmp/resume.log")"
+[ -f "$run/eval.csv" ] || fail "no eval.csv"
+final=$(tail -1 "$run/eval.csv")
+column() { awk -F, -v name="$1" 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i } NR == 2 { print $c[name] }' \
+  <(head -1 "$run/eval.csv"; echo "$final"); }
+env_steps=$(column env_steps) step=$(column train_step)
+# Paced: at the start of the last chunk the learner had every step the replay allowed, and it
+# cannot take more than the steps allowed for all the transitions.
+last=$(cat "$(ls "$run"/actors/gate-0/*.steps | tail -1)")
+low=$(qattn-train --steps-allowed $(( env_steps - last )) --pretrain $PRETRAIN --replay-ratio $RATIO)
+high=$(qattn-train --steps-allowed "$env_steps" --pretrain $PRETRAIN --replay-ratio $RATIO)
+[ "$step" -ge "$low" ] && [ "$step" -le "$high" ] \
+  || fail "learner step $step after $env_steps environment steps (the last chunk $last): expected $low to $high"
+# The processor time split by role adds up to cpu_s, and every role has some.
+sum=$(awk "BEGIN { print $(column cpu_demos_s) + $(column cpu_pretrain_s) + $(column cpu_learner_s) + $(column cpu_actor_s) + $(column cpu_other_s) }")
+awk "BEGIN { exit !($sum - $(column cpu_s) > -1.5 && $sum - $(column cpu_s) < 1.5) }" || fail "roles sum to $sum, cpu_s $(column cpu_s)"
+for role in demos pretrain learner actor; do
+  awk "BEGIN { exit !($(column "cpu_${role}_s") > 0) }" || fail "no processor time for the role $role: $final"
+done
+echo "ok: learner step $step after $env_steps environment steps (allowed $low..$high); cpu $(column cpu_s) s"
