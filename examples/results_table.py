@@ -60,7 +60,7 @@ def failures(paths):
 
 def lookalikes(paths):
     """Per task and label, the failure kinds summed over runs and the share of tries at an
-    object that went for the right one."""
+    object that went for the right one (rows of dicts)."""
     sums = defaultdict(lambda: defaultdict(int))
     for path in paths:
         with open(path, newline="") as f:
@@ -69,14 +69,14 @@ def lookalikes(paths):
                 total["runs"] += 1
                 for kind in ("episodes", "success", "target", "distractor", "elsewhere"):
                     total[kind] += int(row[kind])
-    writer = csv.writer(sys.stdout, lineterminator="\n")
-    writer.writerow(["task", "label", "runs", "episodes", "success", "target", "distractor", "elsewhere",
-                     "tries_at_an_object", "right_share"])
+    table = []
     for (task, label), t in sorted(sums.items()):
         tries = t["success"] + t["target"] + t["distractor"]
-        right = f"{(t['success'] + t['target']) / tries:.3f}" if tries else ""
-        writer.writerow([task, label, t["runs"], t["episodes"], t["success"], t["target"], t["distractor"],
-                         t["elsewhere"], tries, right])
+        table.append({"task": task, "label": label, **{k: t[k] for k in ("runs", "episodes", "success", "target",
+                                                                        "distractor", "elsewhere")},
+                      "tries_at_an_object": tries,
+                      "right_share": f"{(t['success'] + t['target']) / tries:.3f}" if tries else ""})
+    return table
 
 
 def evaluations(paths):
@@ -218,7 +218,7 @@ def main():
         failures(args.runs)
         return
     if args.lookalikes:
-        lookalikes(args.runs)
+        print_table(lookalikes(args.runs), args.markdown)
         return
     if args.tasks:
         print("\n".join(sorted({task for task, _ in evaluations(args.runs)})))

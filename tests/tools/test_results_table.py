@@ -127,12 +127,37 @@ def main():
             ("lookalike_lift_numbered_block", "qte-k10-t10", "2", "100", "100", f"{(19 + 23 + 2) / 100:.3f}"),
             ("lookalike_reach_prism", "qte-k1-t1", "1", "50", "0", "")], summed
 
+        # Paired by seed against C2F-ARM: the seeds both methods have (qte's seed 0 only here),
+        # then a case checked by hand: differences +4, +2, +6, -2, +5 of 50 successes.
+        pairs = rows_of(run("--paired", "c2farm-k1-t0", *paths).stdout)
+        assert [(r["task"], r["label"], r["pairs"], r["mean_difference"]) for r in pairs] == [
+            ("lift_numbered_block", "qte-k10-t10", "1", f"{(19 - 13) / 50:+.3f}")], pairs
+        mine = []
+        for seed, (base, qte) in enumerate([(20, 24), (30, 32), (10, 16), (40, 38), (25, 30)]):
+            mine.append(write_run(d, f"reach_prism_c2farm-k1-t0-seed{seed}.csv", "c2farm-k1-t0", seed, [(base, 9)]))
+            mine.append(write_run(d, f"reach_prism_qte-k10-t10-seed{seed}.csv", "qte-k10-t10", seed, [(qte, 9)]))
+        pair = rows_of(run("--paired", "c2farm-k1-t0", *mine).stdout)
+        assert len(pair) == 1, pair
+        d_rates = [0.08, 0.04, 0.12, -0.04, 0.10]
+        mean = statistics.mean(d_rates)
+        half = 2.7764451 * statistics.stdev(d_rates) / 5 ** 0.5  # t(0.975, 4 df), from a table
+        assert pair[0]["mean_difference"] == f"{mean:+.3f}", pair
+        assert pair[0]["ci95_low"] == f"{mean - half:+.3f}" and pair[0]["ci95_high"] == f"{mean + half:+.3f}", pair
+        # The exact sign-flip p-value: the share of the 32 sign assignments whose |sum| reaches
+        # the observed 0.30: 6 of them (the observed signs, 0.30; -0.04 flipped, 0.38; both 0.04s
+        # flipped, 0.30; and the three mirrored).
+        sums = [abs(sum(s * x for s, x in zip(signs, d_rates)))
+                for signs in __import__("itertools").product((1, -1), repeat=5)]
+        p_value = sum(v >= 0.30 - 1e-12 for v in sums) / 32
+        assert p_value == 6 / 32 and pair[0]["sign_flip_p"] == "0.1875", (pair, p_value)
+        assert pair[0]["per_seed"] == "s0:+0.08 s1:+0.04 s2:+0.12 s3:-0.04 s4:+0.10", pair
+
         empty = os.path.join(d, "empty.csv")
         with open(empty, "w") as f:
             f.write(",".join(COLUMNS) + "\n")
         refused = run(empty, check=False)
         assert refused.returncode != 0 and "empty.csv: no evaluation rows" in refused.stderr, refused
-    print("results_table: tasks apart, last evaluations, means, finals, curves, lookalikes and K ablation as written")
+    print("results_table: tasks apart, last evaluations, means, finals, curves, lookalikes, paired tests and K ablation as written")
 
 
 if __name__ == "__main__":

@@ -1,0 +1,111 @@
+#!/usr/bin/env python3
+"""The results document (docs/results.md) from the committed CSVs alone.
+
+    results_report.py RESULTS_DIR > docs/results.md
+
+One section per takeaway directory of RESULTS_DIR (examples/results/): the final success per
+method (results_table.py's table), every method against C2F-ARM paired by seed (mean
+difference, 95% interval, exact sign-flip p-value), the processor time by role where the runs
+recorded it, where the final agents went (failure_reasons), the pictures that paper-report
+draws, and the directory's reading.md (the paper's claim and our reading, written by hand).
+Every number in the document comes from a CSV; a test checks the document is up to date.
+Standard library only.
+"""
+import glob
+import os
+import statistics
+import sys
+
+import results_table
+
+BASELINE = "c2farm-k1-t0"
+# Section order and titles; a directory not listed here follows, titled by its name.
+TITLES = {
+    "takeaway1": "Takeaway 1: no loss where tree expansion is not needed (Task Set 1)",
+    "takeaway2": "Takeaway 2: a gain under coarse ambiguity (Task Set 2)",
+    "takeaway3": "Takeaway 3: ablations on `reach_prism`",
+    "takeaway4": "Takeaway 4: the real-world task in simulation (`reach_prism`, 10 minutes of training)",
+    "takeaway4-unpaced": "Takeaway 4 without pacing (the earlier protocol, superseded)",
+}
+ROLES = ["demos", "pretrain", "learner", "actor", "other"]
+
+
+def markdown(table, columns=None):
+    if not table:
+        return ""
+    columns = columns or list(table[0].keys())
+    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    lines += ["| " + " | ".join(str(row[c]) for c in columns) + " |" for row in table]
+    return "\n".join(lines)
+
+
+def cpu_by_role(runs):
+    """Mean processor seconds per role at the final evaluation, per task and label, for runs
+    whose CSVs split cpu_s by role."""
+    table = []
+    for (task, label), rows in sorted(runs.items()):
+        if not all(rows[0].get(f"cpu_{role}_s") for role in ROLES):
+            continue
+        row = {"task": task, "label": label, "runs": len(rows),
+               "cpu_s": f"{statistics.mean(float(r['cpu_s']) for r in rows):.0f}"}
+        for role in ROLES:
+            row[role] = f"{statistics.mean(float(r[f'cpu_{role}_s']) for r in rows):.0f}"
+        table.append(row)
+    return table
+
+
+def section(directory, images):
+    name = os.path.basename(directory.rstrip("/"))
+    csvs = sorted(glob.glob(os.path.join(directory, "*-seed*.csv")))
+    out = [f"## {TITLES.get(name, name)}\n"]
+    if not csvs:
+        out.append("No runs are committed yet.\n")
+    else:
+        runs = results_table.final_rows(csvs)
+        out.append(f"{len(csvs)} runs (`examples/results/{name}/`). Final success on the held-out scenes, per method "
+                   "(each run's last evaluation; Wilson 95% interval per run):\n")
+        out.append(markdown([results_table.summary(task, label, rows) for (task, label), rows in sorted(runs.items())]))
+        paired = results_table.paired(runs, BASELINE)
+        if paired:
+            out.append(f"\nEach method against C2F-ARM (`{BASELINE}`), paired by seed: mean difference in final "
+                       "success rate, its 95% interval (Student's t over the paired differences) and the two-sided "
+                       "p-value of the exact sign-flip permutation test:\n")
+            out.append(markdown(paired))
+        cpu = cpu_by_role(runs)
+        if cpu:
+            out.append("\nProcessor seconds by role up to the final evaluation (mean over runs; evaluation excluded):\n")
+            out.append(markdown(cpu))
+        failures = sorted(glob.glob(os.path.join(directory, "failures", "*.csv")))
+        if failures:
+            out.append("\nWhere the final agents went on the held-out scenes (episodes summed over runs; "
+                       "`right_share`: of the tries at an object, the share at the right one):\n")
+            out.append(markdown(results_table.lookalikes(failures)))
+    pictures = [p for p in (f"{name}.png", f"{name}_curves.png", f"{name}_k.png")
+                if os.path.exists(os.path.join(images, p))]
+    if pictures:
+        out.append("\n" + " ".join(f"![{p}](../examples/images/{p})" for p in pictures) + "\n")
+    reading = os.path.join(directory, "reading.md")
+    if os.path.exists(reading):
+        with open(reading) as f:
+            out.append("\n" + f.read().strip() + "\n")
+    return "\n".join(out)
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit(__doc__.strip().splitlines()[2].strip())
+    results = sys.argv[1]
+    images = os.path.join(results, "..", "images")
+    names = sorted(os.path.basename(d.rstrip("/")) for d in glob.glob(os.path.join(results, "takeaway*/")))
+    names.sort(key=lambda n: (list(TITLES).index(n) if n in TITLES else len(TITLES), n))
+    print("# Results: the paper's four takeaways\n")
+    print("Generated by `make -C examples paper-report` from the CSVs under `examples/results/` "
+          "(do not edit by hand: a test compares it with the CSVs). Success rates are over 50 held-out scenes "
+          "that no run explored or was shown; seeds pair runs of different methods on the same demonstrations "
+          "and exploration scenes.\n")
+    for name in names:
+        print(section(os.path.join(results, name), images))
+
+
+if __name__ == "__main__":
+    main()
