@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Pictures and numbers of a task's coarse ambiguity (README, "The tasks"): the first front
+# Pictures and numbers of a task's coarse ambiguity (docs/tasks.md): the first front
 # frame of one demonstration, what depth 0 sees, the depth-1 grids around the target and the
 # distractors, and ambiguity.py's comparison of them.
 # Usage: ambiguity.sh TASK [SEED] [IMAGE] [centres|places]   (with the built programs on

@@ -56,11 +56,11 @@ static cli::Usage usage() {
   u.options.push_back(cli::output_file());
   u.examples = {
       {"obs-pack --rgb rec/color_%06d.png --depth rec/depth_%06d.png --intrinsics 615.2,615.0,320.5,240.1 "
-       "--camera-pose 1.0,0,1.4,-0.65,0.65,-0.27,0.27 --joints rec/joints.csv > real.rec",
+       "--camera-pose 1.05,0,1.602,-0.63365,-0.63365,0.31383,0.31383 --joints rec/joints.csv > real.rec",
        "a RealSense recording with the arm's joint log"},
       {"obs-pack ... < /dev/null | qte-select --checkpoint run/latest.rec --k 10 --png q/ | plan-path | stream-dump --type trajectory",
        "what the learned agent would do on each saved frame"},
-      {"obs-pack --pcd clouds/%06d.pcd --camera-pose 1.0,0,1.4,-0.65,0.65,-0.27,0.27 | voxelize --png grids/",
+      {"obs-pack --pcd clouds/%06d.pcd --camera-pose 1.05,0,1.602,-0.63365,-0.63365,0.31383,0.31383 | voxelize --png grids/",
        "voxelize saved clouds and look at the grids"},
   };
   u.see_also = {"sim-step(1)", "voxelize(1)", "qte-select(1)", "plan-path(1)", "qte-stream(5)"};

@@ -39,7 +39,7 @@ static cli::Usage usage() {
       "Every default is the published value except the batch (32, published 128: a quarter of "
       "the time per step on a CPU) and the network (light, published arm: a twentieth of the cost "
       "per step); priorities count each depth once (the public code counts depth 0 twice). "
-      "The README's table of settings gives each with its reason.",
+      "The table of settings in docs/learner.md gives each with its reason.",
       "Checkpoints go to DIR/step-NNNNNNNN.rec every --checkpoint-every steps (the last --keep "
       "kept) and DIR/latest.rec always names the newest; each is written whole or not at "
       "all. The first record of a checkpoint holds the online networks and the bounds and "

@@ -1,5 +1,5 @@
 // The learner's settings: every hyper-parameter of C2F-ARM's Q-attention learning, with the
-// published value as default unless the README's table of settings says why not.
+// published value as default unless the table of settings in docs/learner.md says why not.
 #pragma once
 
 #include "qattention/tree_expansion.hpp"
@@ -14,7 +14,7 @@ namespace qte::learner {
 struct LearnerConfig {
   nets::NetConfig net;  // architecture, base channels, voxels, channels, proprio (depth ignored)
   voxels::CoarseToFine hierarchy;
-  int batch = 32;  // published 128: 4x the cost per step on a CPU (README, settings)
+  int batch = 32;  // published 128: 4x the cost per step on a CPU (docs/learner.md, settings)
   double gamma = 0.99;
   double reward_scale = 0.01;
   double tau = 0.0025;
