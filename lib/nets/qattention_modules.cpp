@@ -1,4 +1,5 @@
-// The two architectures. `arm` follows shared/bench/torch_qattention_ref.py layer for layer
+// The two architectures. `arm` follows the PyTorch reference of ARM's published Q-attention
+// network (its `Net` module; not part of this repository) layer for layer
 // (same module names, so the same parameter names and counts); `light` is the CPU default,
 // chosen by measurement (tests/bench/bench_nets.cpp).
 #include "nets/qattention_modules.hpp"

@@ -25,7 +25,8 @@ struct Trunk {
 };
 
 // One depth's network. Parameter names are those of the architecture's module tree; for
-// `arm` they are exactly those of Net in shared/bench/torch_qattention_ref.py, so Python can
+// `arm` they are exactly those of the PyTorch reference of ARM's published Q-attention network
+// (its `Net` module; not part of this repository), so Python can
 // load our weights into it by name.
 class QAttentionModule : public torch::nn::Module {
  public:

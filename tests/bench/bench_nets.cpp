@@ -5,8 +5,8 @@
 // (the backward pass computes both input and weight gradients, each as costly as the forward).
 // Element-wise work (activations, pooling, upsampling, Adam) is not counted.
 //
-// Compare with the PyTorch reference, run back to back:
-//   /usr/bin/python3 shared/bench/torch_qattention_ref.py 2
+// Compare with the PyTorch reference of ARM's published Q-attention network (its `Net`
+// module; not part of this repository), run back to back with 2 threads.
 // Options: --quick (skip arm at batch 128), --sweep (light at 8..32 base channels),
 //          --light (one line: light's b32 step at depth 0 and the last, for bench_light_vs_torch),
 //          --threads N (default 2), --export DIR (files for torch_reference_step.py, which

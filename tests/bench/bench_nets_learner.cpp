@@ -5,7 +5,8 @@
 // transitions are pick_and_lift demonstrations recorded in-process (10 episodes, 128x128).
 //
 // The reference's bare network step (forward + backward + Adam at one depth, no data) is
-// printed by /usr/bin/python3 shared/bench/torch_qattention_ref.py 2; run it back to back.
+// printed by the PyTorch reference of ARM's published Q-attention network (its `Net` module;
+// not part of this repository) with 2 threads; run it back to back (tests/bench/torch_light_ref.py is the same for `light`).
 // Options: --arch light|arm, --batch B, --tree-target K, --steps N, --threads N.
 //   --compare K: instead, full steps with plain (double-DQN) and tree-expanded (K) targets
 //   interleaved step by step, so that a noisy machine hits both alike; prints the ratio.

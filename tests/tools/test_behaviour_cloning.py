@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The whole data path, checked by behaviour cloning (issue 6): 20 reach_target demonstrations
+"""The whole data path, checked by behaviour cloning: 20 reach_target demonstrations
 (variation 0: the red target among two distractors of other colours) through keyframe into
 qattn-train, 300 steps on the demonstrations alone; then on 20 held-out demonstrations the
 greedy coarse-to-fine choice of qte-select --k 1 on each first observation must land within

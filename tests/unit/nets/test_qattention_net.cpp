@@ -200,8 +200,9 @@ TEST(QAttentionNet, HeadsOfChosenLeavesEqualTheWholeBatches) {
   }
 }
 
-// Numbers printed by the reference, shared/bench/torch_qattention_ref.py, whose Net takes 11
-// proprio inputs and 10 channels at 64 base kernels:
+// Numbers printed by the PyTorch reference of ARM's published Q-attention network (its `Net`
+// module, torch_qattention_ref.py; not part of this repository), whose Net takes 11 proprio
+// inputs and 10 channels at 64 base kernels:
 //   /usr/bin/python3 -c "import sys; sys.argv = ['x']; exec(open('torch_qattention_ref.py')
 //     .read().split('if __name__')[0]); print([sum(p.numel() for p in Net(d).parameters())
 //     for d in (False, True)])"

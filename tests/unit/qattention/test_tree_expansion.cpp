@@ -440,7 +440,7 @@ TEST(TreeExpansion, NonFiniteQValuesAreAnError) {
   }
 }
 
-// Adaptive branching (issue 16): a node expands as many voxels as its own Q volume is unsure
+// Adaptive branching: a node expands as many voxels as its own Q volume is unsure
 // about, within [1, K_max].
 TEST(Branching, OneClearWinnerExpandsOneBranch) {
   std::vector<float> q(kCells, 0.0f);

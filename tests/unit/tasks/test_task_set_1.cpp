@@ -1,4 +1,4 @@
-// Task Set 1's six tasks (issue 15): each scene's objects where the task says, success true
+// Task Set 1's six tasks: each scene's objects where the task says, success true
 // for what the task asks and false for the near misses (the wrong object, not far enough,
 // still held, beside the goal), the expert's poses ending in success when carried out by hand
 // (teleported arm, real grasp and physics), and a seed deciding the scene.
