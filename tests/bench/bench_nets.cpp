@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "machine_peak.hpp"
 #include "nets/checkpoint.hpp"
 #include "nets/qattention_modules.hpp"
 #include "stream/writer.hpp"
@@ -94,6 +95,8 @@ struct Figures {
   double train32 = 0, train128 = 0, forward1 = 0;
 };
 
+double peak_gflops = 0;  // the machine's measured fp32 peak on the benchmark's threads (main)
+
 Figures bench(Architecture architecture, int base_channels, bool last, bool with_batch_128, int proprio) {
   NetConfig config;
   config.architecture = architecture;
@@ -109,9 +112,10 @@ Figures bench(Architecture architecture, int base_channels, bool last, bool with
   if (with_batch_128) f.train128 = train_step_seconds(net, 128, heavy ? 1 : 3);
   f.forward1 = forward_seconds(net, heavy ? 10 : 50);
   const auto train_gflops = [&](int batch, double t) { return macs * 2 * 3 * batch / t / 1e9; };
-  std::printf("%-5s k=%-2d %-10s %8lld params %6.3f GMAC/sample | train b32 %7.3f s (%5.1f GFLOP/s)",
+  std::printf("%-5s k=%-2d %-10s %8lld params %6.3f GMAC/sample | train b32 %7.3f s (%5.1f GFLOP/s, %2.0f%% of peak)",
               architecture_name(architecture), base_channels, last ? "last depth" : "depth 0",
-              static_cast<long long>(net.parameter_count()), macs / 1e9, f.train32, train_gflops(32, f.train32));
+              static_cast<long long>(net.parameter_count()), macs / 1e9, f.train32, train_gflops(32, f.train32),
+              100 * train_gflops(32, f.train32) / peak_gflops);
   if (with_batch_128) std::printf(" | b128 %7.3f s (%5.1f GFLOP/s)", f.train128, train_gflops(128, f.train128));
   std::printf(" | fwd b1 %7.2f ms (%5.1f GFLOP/s)\n", f.forward1 * 1e3, macs * 2 / f.forward1 / 1e9);
   std::fflush(stdout);
@@ -202,6 +206,9 @@ int main(int argc, char** argv) {
     return 0;
   }
   std::printf("threads=%d, grid 16^3 x 10 channels, proprio 4 (arm also with the reference's 11)\n", threads);
+  const qte::bench::Peak peak = qte::bench::measure_fp32_peak(threads);
+  peak_gflops = peak.gflops;
+  std::printf("machine peak: %.0f GFLOP/s fp32 on %d threads (%s, measured)\n", peak.gflops, threads, peak.isa.c_str());
   if (sweep || channels_last) {
     for (int k : {8, 16, 24, 32}) bench(Architecture::light, k, false, false, 4);
     return 0;

@@ -26,6 +26,8 @@
 #include "keyframes/transitions.hpp"
 #include "learner/q_learner.hpp"
 #include "learner/targets.hpp"
+#include "machine_peak.hpp"
+#include "nets/qattention_modules.hpp"
 #include "replay/replay_buffer.hpp"
 
 using namespace qte;
@@ -143,5 +145,15 @@ int main(int argc, char** argv) {
               full, median(sample_s), assemble, targets, full - median(sample_s) - assemble - targets);
   std::printf("  per depth        %.3f s  (full step / depths: compare with the reference's bare step per depth)\n",
               full / config.hierarchy.depths);
+  // The trunk's share of the machine: FLOPs from the layers' multiply-accumulates (x2), x3 for
+  // forward + backward (input and weight gradients), over the forward+backward+Adam time.
+  double macs = 0;
+  for (const nets::QAttentionNet& net : learner.online()) macs += static_cast<double>(net.module().multiply_accumulates());
+  const double trunk_s = full - median(sample_s) - assemble - targets, trunk_gflop = macs * 2 * 3 * batch / 1e9;
+  const bench::Peak peak = bench::measure_fp32_peak(threads);
+  std::printf("trunk: %.1f GFLOP/s, %.0f%% of peak (forward + backward of all depths: %.1f GFLOP in %.3f s; "
+              "peak %.0f GFLOP/s fp32 on %d threads, %s)\n",
+              trunk_gflop / trunk_s, 100 * trunk_gflop / trunk_s / peak.gflops, trunk_gflop, trunk_s, peak.gflops, threads,
+              peak.isa.c_str());
   return 0;
 }

@@ -1,0 +1,89 @@
+// The machine's own fp32 peak, measured: a loop of independent fused multiply-adds on every
+// thread at once, with the widest vectors this CPU has (chosen at run time: AVX-512, AVX2 +
+// FMA, or SSE2 multiply and add), so that the network benchmarks can say what share of the
+// hardware they reach on whatever processor they run (the machines differ from day to day).
+#pragma once
+
+#include <immintrin.h>
+
+#include <chrono>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace qte::bench {
+
+struct Peak {
+  double gflops = 0;  // fp32 FLOP/s of all threads together, 1e9
+  std::string isa;    // the instructions the loop used
+};
+
+namespace peak_detail {
+
+constexpr int kAccumulators = 12;  // enough independent chains to hide the FMA latency
+constexpr long kIterations = 20'000'000;
+
+// Each returns a value depending on every accumulator, so nothing is optimised away.
+__attribute__((target("avx512f"))) inline float loop_avx512() {
+  __m512 acc[kAccumulators];
+  for (int i = 0; i < kAccumulators; ++i) acc[i] = _mm512_set1_ps(0.001f * static_cast<float>(i));
+  const __m512 a = _mm512_set1_ps(0.999999f), b = _mm512_set1_ps(1e-7f);
+  for (long n = 0; n < kIterations; ++n)
+    for (int i = 0; i < kAccumulators; ++i) acc[i] = _mm512_fmadd_ps(acc[i], a, b);
+  __m512 sum = acc[0];
+  for (int i = 1; i < kAccumulators; ++i) sum = _mm512_add_ps(sum, acc[i]);
+  float out[16];
+  _mm512_storeu_ps(out, sum);
+  return out[0] + out[15];
+}
+
+__attribute__((target("avx2,fma"))) inline float loop_avx2() {
+  __m256 acc[kAccumulators];
+  for (int i = 0; i < kAccumulators; ++i) acc[i] = _mm256_set1_ps(0.001f * static_cast<float>(i));
+  const __m256 a = _mm256_set1_ps(0.999999f), b = _mm256_set1_ps(1e-7f);
+  for (long n = 0; n < kIterations; ++n)
+    for (int i = 0; i < kAccumulators; ++i) acc[i] = _mm256_fmadd_ps(acc[i], a, b);
+  __m256 sum = acc[0];
+  for (int i = 1; i < kAccumulators; ++i) sum = _mm256_add_ps(sum, acc[i]);
+  float out[8];
+  _mm256_storeu_ps(out, sum);
+  return out[0] + out[7];
+}
+
+inline float loop_sse2() {  // x86-64's baseline: a multiply and an add (2 FLOPs a lane as well)
+  __m128 acc[kAccumulators];
+  for (int i = 0; i < kAccumulators; ++i) acc[i] = _mm_set1_ps(0.001f * static_cast<float>(i));
+  const __m128 a = _mm_set1_ps(0.999999f), b = _mm_set1_ps(1e-7f);
+  for (long n = 0; n < kIterations; ++n)
+    for (int i = 0; i < kAccumulators; ++i) acc[i] = _mm_add_ps(_mm_mul_ps(acc[i], a), b);
+  __m128 sum = acc[0];
+  for (int i = 1; i < kAccumulators; ++i) sum = _mm_add_ps(sum, acc[i]);
+  return _mm_cvtss_f32(sum);
+}
+
+}  // namespace peak_detail
+
+// Runs the loop on `threads` threads at once; FLOPs = 2 per lane per multiply-add.
+inline Peak measure_fp32_peak(int threads) {
+  using namespace peak_detail;
+  float (*loop)() = loop_sse2;
+  int lanes = 4;
+  Peak peak{0, "SSE2 mul+add"};
+  if (__builtin_cpu_supports("avx512f")) {
+    loop = loop_avx512, lanes = 16, peak.isa = "AVX-512 FMA";
+  } else if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
+    loop = loop_avx2, lanes = 8, peak.isa = "AVX2 FMA";
+  }
+  std::vector<float> sink(threads);
+  std::vector<std::thread> pool;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int t = 0; t < threads; ++t) pool.emplace_back([&, t] { sink[t] = loop(); });
+  for (auto& th : pool) th.join();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  volatile float keep = sink[0];
+  (void)keep;
+  peak.gflops = 2.0 * lanes * kAccumulators * static_cast<double>(kIterations) * threads / seconds / 1e9;
+  return peak;
+}
+
+}  // namespace qte::bench
