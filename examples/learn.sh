@@ -45,6 +45,7 @@ task=$1 run=$2
 : "${ARCH:=light}" "${BATCH:=32}" "${RATIO:=0.5}" "${PRETRAIN:=200}" "${START_AFTER:=0}"
 : "${LEARNER_THREADS:=1}" "${EPSILON:=0.1}" "${ROTATION_NOISE:=1}" "${CHECKPOINT_EVERY:=25}" "${LABEL:=k$ACT_K-$TARGET_K}"
 : "${N_STEP:=1}" "${ACTORS:=1}" "${CPU_BUDGET:=0}" "${K_MARGIN:=0.02}" "${K_MAX:=10}" "${ROLE:=all}" "${ACTOR_INDEX:=0}"
+: "${ALSO_ACT_K:=}"
 mkdir -p "$run/actors" "$run/eval"
 # Adaptive K (ACT_K or TARGET_K 'auto'): each node expands the voxels within K_MARGIN of its
 # best Q, at most K_MAX; the options go only to the programs whose K is 'auto'.
@@ -343,4 +344,12 @@ if [ ! -f "$run/failures.csv" ]; then
     "$ACT_K" "$IMAGE" "$EVAL_EPISODES" "$LABEL" "$SEED" $act_branching > "$run/failures.csv.tmp" 2>> "$run/actor.log" \
     && mv "$run/failures.csv.tmp" "$run/failures.csv" || log "$task $LABEL seed $SEED: no failure analysis (see actor.log)"
 fi
+# ALSO_ACT_K=K[,K...]: the final networks acting with other K as well (trained with one method,
+# acting with another), each into failures-act-kK.csv.
+for k in ${ALSO_ACT_K//,/ }; do
+  [ "$k" != "$ACT_K" ] && [ ! -f "$run/failures-act-k$k.csv" ] || continue
+  VARIATION=$VARIATION EVAL_SEED=$EVAL_SEED bash "$(dirname "$0")/failure_reasons.sh" "$task" "$run/eval/checkpoint.rec" \
+    "$k" "$IMAGE" "$EVAL_EPISODES" "$LABEL" "$SEED" > "$run/failures-act-k$k.csv.tmp" 2>> "$run/actor.log" \
+    && mv "$run/failures-act-k$k.csv.tmp" "$run/failures-act-k$k.csv" || log "$task $LABEL seed $SEED: no analysis acting with K = $k"
+done
 log "$task $LABEL seed $SEED: done; $run/eval.csv"

@@ -80,6 +80,11 @@ def section(directory, images):
             out.append("\nWhere the final agents went on the held-out scenes (episodes summed over runs; "
                        "`right_share`: of the tries at an object, the share at the right one):\n")
             out.append(markdown(results_table.lookalikes(failures)))
+        others = sorted(glob.glob(os.path.join(directory, "acting", "*.csv")))
+        if others:
+            out.append("\nTrained by one method, acting with each K: the final networks on the same held-out scenes "
+                       "(episodes summed over runs; `acting_k` 1 is greedy without tree expansion):\n")
+            out.append(markdown(results_table.acting(failures + others)))
     pictures = [p for p in (f"{name}.png", f"{name}_curves.png", f"{name}_k.png")
                 if os.path.exists(os.path.join(images, p))]
     if pictures:

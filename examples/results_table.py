@@ -7,6 +7,7 @@
     results_table.py --failures FAILURES.csv...
     results_table.py --lookalikes FAILURES.csv...
     results_table.py --paired BASELINE [--markdown] RUN.csv...
+    results_table.py --acting FAILURES.csv...
 
 One row per task and label (method): the runs' final evaluations (the last eval_point of each run):
 the environment and learner steps they had taken (means), their success's mean and sample
@@ -26,7 +27,10 @@ target), to set beside the chance of picking among the task's lookalikes. --pair
 compares every other label with the label BASELINE, paired by seed (the seeds both have): the
 mean difference in final success, its 95% interval (Student's t over the paired differences),
 and the two-sided p-value of the exact sign-flip permutation test (all 2^n sign assignments of
-the n differences; the test makes no assumption about their distribution). Standard library only.
+the n differences; the test makes no assumption about their distribution). --acting sums
+failure_reasons CSVs per task, label (how the networks were trained) and the K they acted with:
+from the name's _act-kK suffix (learn.sh's ALSO_ACT_K), else the label's own (LABEL = ...-kK-...).
+Standard library only.
 """
 import argparse
 import csv
@@ -77,6 +81,26 @@ def lookalikes(paths):
                       "tries_at_an_object": tries,
                       "right_share": f"{(t['success'] + t['target']) / tries:.3f}" if tries else ""})
     return table
+
+
+def acting(paths):
+    """Trained-by x acting-with: failure kinds summed per task, label and acting K."""
+    sums = defaultdict(lambda: defaultdict(int))
+    for path in paths:
+        suffix = re.search(r"_act-k(\d+)\.csv$", path)
+        with open(path, newline="") as f:
+            for row in csv.DictReader(f):
+                own = re.search(r"k(\d+)-t", row["label"])
+                act_k = suffix.group(1) if suffix else own.group(1) if own else ""
+                name = re.sub(r"_act-k\d+\.csv$", ".csv", path)
+                total = sums[(task_of(name, row), row["label"], act_k)]
+                total["runs"] += 1
+                for kind in ("episodes", "success", "target", "distractor", "elsewhere", "failed_actions"):
+                    total[kind] += int(row.get(kind) or 0)
+    return [{"task": task, "label": label, "acting_k": k, **{c: t[c] for c in ("runs", "episodes", "success", "target",
+                                                                              "distractor", "elsewhere", "failed_actions")},
+             "success_rate": f"{t['success'] / t['episodes']:.3f}" if t["episodes"] else ""}
+            for (task, label, k), t in sorted(sums.items(), key=lambda kv: (kv[0][0], kv[0][1], int(kv[0][2] or 0)))]
 
 
 def evaluations(paths):
@@ -212,6 +236,8 @@ def main():
     parser.add_argument("--curves", action="store_true", help="every evaluation of --task's runs, as CSV")
     parser.add_argument("--task", help="the task of --curves")
     parser.add_argument("--paired", metavar="BASELINE", help="every other label against BASELINE, paired by seed")
+    parser.add_argument("--acting", action="store_true",
+                        help="failure_reasons CSVs summed per task, label and the K the networks acted with")
     parser.add_argument("runs", nargs="+")
     args = parser.parse_args()
     if args.failures:
@@ -219,6 +245,9 @@ def main():
         return
     if args.lookalikes:
         print_table(lookalikes(args.runs), args.markdown)
+        return
+    if args.acting:
+        print_table(acting(args.runs), args.markdown)
         return
     if args.tasks:
         print("\n".join(sorted({task for task, _ in evaluations(args.runs)})))

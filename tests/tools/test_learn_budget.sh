@@ -43,9 +43,12 @@ pgrep -f "$run" > /dev/null && fail "programs of the run still running: $(pgrep 
 
 # 2. Resume with a budget this run has nearly spent: it ends by itself, with an evaluation.
 spent=$(awk -v t="$(getconf CLK_TCK)" '{ print int(($1 + $2 + $3 + $4 + $5) / t) }' "$run/cpu_ticks")
-CPU_BUDGET=$(( spent + 3 )) bash "$learn" reach_target "$run" 2> "$tmp/resume.log" \
+CPU_BUDGET=$(( spent + 3 )) ALSO_ACT_K=1,2 bash "$learn" reach_target "$run" 2> "$tmp/resume.log" \
   || fail "the resumed run failed: $(tail -5 "$tmp/resume.log")"
 [ -f "$run/eval.csv" ] || fail "no eval.csv"
+# The final networks acting with another K as well (ALSO_ACT_K; its own K = 1 is failures.csv).
+[ -f "$run/failures.csv" ] && [ -f "$run/failures-act-k2.csv" ] && [ ! -f "$run/failures-act-k1.csv" ] \
+  || fail "failure analyses: $(ls "$run")"
 final=$(tail -1 "$run/eval.csv")
 column() { awk -F, -v name="$1" 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i } NR == 2 { print $c[name] }' \
   <(head -1 "$run/eval.csv"; echo "$final"); }

@@ -152,6 +152,23 @@ def main():
         assert p_value == 6 / 32 and pair[0]["sign_flip_p"] == "0.1875", (pair, p_value)
         assert pair[0]["per_seed"] == "s0:+0.08 s1:+0.04 s2:+0.12 s3:-0.04 s4:+0.10", pair
 
+        # Trained-by x acting-with: a run's own failures (its label's K) and those acting with
+        # another K (learn.sh's ALSO_ACT_K, named ..._act-kK.csv) kept apart, summed over seeds.
+        crossed = []
+        for name, label, kinds in [("reach_prism_c2farm-k1-t0-seed0.csv", "c2farm-k1-t0", (30, 5, 15, 0)),
+                                   ("reach_prism_c2farm-k1-t0-seed1.csv", "c2farm-k1-t0", (20, 10, 20, 0)),
+                                   ("reach_prism_c2farm-k1-t0-seed0_act-k10.csv", "c2farm-k1-t0", (40, 0, 10, 0)),
+                                   ("reach_prism_qte-k10-t10-seed0_act-k1.csv", "qte-k10-t10", (25, 0, 20, 5))]:
+            path = os.path.join(d, name)
+            with open(path, "w") as f:
+                f.write("label,seed,episodes,success,target,distractor,elsewhere,failed_actions\n")
+                f.write(f"{label},{name.split('seed')[1][0]},50,{','.join(map(str, kinds))},1\n")
+            crossed.append(path)
+        cells = rows_of(run("--acting", *crossed).stdout)
+        assert [(r["task"], r["label"], r["acting_k"], r["runs"], r["success"], r["success_rate"]) for r in cells] == [
+            ("reach_prism", "c2farm-k1-t0", "1", "2", "50", "0.500"), ("reach_prism", "c2farm-k1-t0", "10", "1", "40", "0.800"),
+            ("reach_prism", "qte-k10-t10", "1", "1", "25", "0.500")], cells
+
         empty = os.path.join(d, "empty.csv")
         with open(empty, "w") as f:
             f.write(",".join(COLUMNS) + "\n")
