@@ -270,7 +270,11 @@ wait_for_learner() {
   local want; want=$(steps_allowed "$1")
   want=$(( want / CHECKPOINT_EVERY * CHECKPOINT_EVERY ))
   while [ "$(learner_step)" -lt "$want" ]; do check_learner; sleep 0.5; done
-  if [ "$pretraining" = 1 ]; then pretrain_ticks=$(stat_ticks "$learner" 14 15) pretraining=0; fi
+  # Pretraining ends at step PRETRAIN (the first evaluation waits for it when PRETRAIN is a
+  # multiple of CHECKPOINT_EVERY; otherwise up to a checkpoint interval of training counts too).
+  if [ "$pretraining" = 1 ] && [ "$(learner_step)" -ge "$PRETRAIN" ]; then
+    pretrain_ticks=$(stat_ticks "$learner" 14 15) pretraining=0
+  fi
 }
 # Greedy episodes of one checkpoint on the held-out seeds -> one CSV row.
 # eval_point: the budget the evaluation stands for (0, EVAL_EVERY, ..., ENV_STEPS); env_steps
