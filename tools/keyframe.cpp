@@ -47,6 +47,7 @@ static cli::Usage usage() {
       {"keep-failed", "", "also convert unsuccessful episodes (reward 0 throughout)", ""},
       {"not-demo", "", "mark the transitions as the agent's own, not demonstrations", ""},
       {"append", "", "append to --output (a growing replay file)", ""},
+      {"repair", "", "with --append: cut a torn last record (left by a killed writer) off --output instead of refusing to append behind it", ""},
       {"agent", "", "convert the agent's episodes (obs and action records) instead of demonstrations", ""},
   };
   u.options.push_back(cli::output_file());
@@ -73,6 +74,8 @@ static void run(const cli::Arguments& args) {
 
   stream::WriteOptions write_options;
   if (args.flag("append")) write_options.mode = stream::WriteMode::append;
+  write_options.repair = args.flag("repair");
+  write_options.inputs = {args.input()};
   stream::RecordReader reader(args.input());
   stream::RecordWriter writer(args.text("output"), write_options);
   const auto convert_all = [&](auto&& converter) {

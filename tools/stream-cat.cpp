@@ -18,11 +18,15 @@ static cli::Usage usage() {
       "record on the way (a damaged input stops with one line naming file, record and byte "
       "offset; the output file is then not created). Records can be filtered by type and "
       "counted. With --append the records are added to the end of an existing file, one whole "
-      "record at a time under a lock, which is how several actors feed one replay file.",
+      "record at a time under a lock, which is how several actors feed one replay file. The file "
+      "appended to must be a record stream ending in a whole record and none of the inputs; "
+      "otherwise nothing is written and one line says where it stops being one (a torn last "
+      "record, left by a killed writer, is cut off with --repair).",
   };
   u.arguments = {cli::input_files()};
   u.options = {
       {"append", "", "append to --output instead of replacing it", ""},
+      {"repair", "", "with --append: cut a torn last record (left by a killed writer) off --output instead of refusing to append behind it", ""},
       {"type", "T", "keep only records of type T", "", true},
       {"exclude", "T", "drop records of type T", "", true},
       {"where", "NAME=VALUE", "keep only records whose scalar or text field NAME equals VALUE (numbers compare as numbers)", "", true},
@@ -78,6 +82,8 @@ static void run(const cli::Arguments& args) {
   read_options.max_record_bytes = static_cast<uint64_t>(args.integer("max-record-bytes"));
   stream::WriteOptions write_options;
   if (args.flag("append")) write_options.mode = stream::WriteMode::append;
+  write_options.repair = args.flag("repair");
+  write_options.inputs = files;
   stream::RecordWriter writer(args.text("output"), write_options);
   for (const std::string& file : files) {
     stream::RecordReader reader(file, read_options);

@@ -24,6 +24,7 @@ static cli::Usage usage() {
                  {"FIELD", "field specifications, see above", true, true}};
   u.options = {
       {"append", "", "append to --output instead of replacing it", ""},
+      {"repair", "", "with --append: cut a torn last record (left by a killed writer) off --output instead of refusing to append behind it", ""},
       {"compress", "", "zstd-compress arrays of 256 bytes or more", ""},
   };
   u.options.push_back(cli::output_file());
@@ -52,6 +53,7 @@ static void run(const cli::Arguments& args) {
   }
   stream::WriteOptions options;
   if (args.flag("append")) options.mode = stream::WriteMode::append;
+  options.repair = args.flag("repair");
   stream::RecordWriter writer(args.text("output"), options);
   writer.write(record);
   writer.close();

@@ -339,6 +339,9 @@ int run_tool(int argc, char** argv, const Usage& usage,
              const std::function<void(const Arguments&)>& run) {
   // EPIPE arrives as an error from write() instead of killing the process; see BrokenPipe.
   ::signal(SIGPIPE, SIG_IGN);
+  // Likewise EFBIG for the file-size limit (SIGXFSZ would kill the process half-way through a
+  // record): the writers then cut back what they wrote, as for a full disk.
+  ::signal(SIGXFSZ, SIG_IGN);
   const std::string prefix = usage.name + ": ";
   try {
     const Arguments args = parse(usage, std::vector<std::string>(argv + 1, argv + argc));
