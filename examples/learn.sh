@@ -47,6 +47,11 @@ task=$1 run=$2
 : "${N_STEP:=1}" "${ACTORS:=1}" "${CPU_BUDGET:=0}" "${K_MARGIN:=0.02}" "${K_MAX:=10}" "${ROLE:=all}" "${ACTOR_INDEX:=0}"
 : "${ALSO_ACT_K:=}"
 mkdir -p "$run/actors" "$run/eval"
+# The script's own waiting costs no process (it is counted in the budget, and a method that
+# takes longer would pay more for it): a read with a timeout on a FIFO nobody writes.
+[ -p "$run/actors/.tick" ] || mkfifo "$run/actors/.tick"
+exec {tick}<> "$run/actors/.tick"
+nap() { read -r -t "$1" -u "$tick" _ || true; }
 # Adaptive K (ACT_K or TARGET_K 'auto'): each node expands the voxels within K_MARGIN of its
 # best Q, at most K_MAX; the options go only to the programs whose K is 'auto'.
 branching() {  # K -> the options that go with it
@@ -203,7 +208,7 @@ run_round() {  # CHUNK...
     done
     [ "$pending" = 1 ] || return 0
     check_learner
-    sleep 0.2
+    nap 0.2
   done
 }
 stop_actors() {  # at a chunk boundary: every actor ends its pipeline
@@ -216,7 +221,7 @@ stop_actors() {  # at a chunk boundary: every actor ends its pipeline
 # the learner says it is done.
 if [ "$ROLE" = actor ]; then
   mkdir -p "$run/actors"
-  until [ -f "$run/ckpt/latest.rec" ]; do sleep 2; done
+  until [ -f "$run/ckpt/latest.rec" ]; do nap 2; done
   rm -f "$(gate_dir "$ACTOR_INDEX")"/*.go "$(gate_dir "$ACTOR_INDEX")/stop"
   trap 'kill_tree "${actor_pids[@]}"' EXIT
   start_actor "$ACTOR_INDEX"
@@ -256,10 +261,17 @@ qattn-train --follow --resume --stop-file "$run/actor.done" --replay-ratio "$RAT
   --checkpoint-dir "$run/ckpt" --metrics "$run/train.csv" "${inputs[@]}" 2>> "$run/train.log" &
 learner=$!
 trap 'kill_tree $(jobs -p)' EXIT  # the learner and the actors, with every program they started
-while [ ! -f "$run/ckpt/latest.rec" ]; do check_learner; sleep 0.5; done
+while [ ! -f "$run/ckpt/latest.rec" ]; do check_learner; nap 0.5; done
 
 # The learner's newest step, from its checkpoint names.
-learner_step() { ls "$run/ckpt" | sed -n 's/^step-0*\([0-9][0-9]*\)\.rec$/\1/p' | sort -n | tail -1; }
+learner_step() {  # (shell builtins only: it runs twice a second)
+  local f n best=-1
+  for f in "$run"/ckpt/step-[0-9]*.rec; do
+    n=${f##*/step-} n=${n%.rec}
+    [[ $n =~ ^[0-9]+$ ]] && (( 10#$n > best )) && best=$(( 10#$n ))
+  done
+  echo "$best"
+}
 pretraining=$(( $(learner_step) < PRETRAIN ))  # pretraining happens in this process tree
 # Waits until the learner has taken the steps the replay ratio allows for `agent` transitions.
 # The gradient steps the replay ratio allows after N agent transitions: what
@@ -269,7 +281,7 @@ steps_allowed() { awk -v n="$1" -v p="$PRETRAIN" -v r="$RATIO" 'BEGIN { printf "
 wait_for_learner() {
   local want; want=$(steps_allowed "$1")
   want=$(( want / CHECKPOINT_EVERY * CHECKPOINT_EVERY ))
-  while [ "$(learner_step)" -lt "$want" ]; do check_learner; sleep 0.5; done
+  while [ "$(learner_step)" -lt "$want" ]; do check_learner; nap 0.5; done
   # Pretraining ends at step PRETRAIN (the first evaluation waits for it when PRETRAIN is a
   # multiple of CHECKPOINT_EVERY; otherwise up to a checkpoint interval of training counts too).
   if [ "$pretraining" = 1 ] && [ "$(learner_step)" -ge "$PRETRAIN" ]; then
@@ -307,7 +319,7 @@ while :; do
   if [ ! -f "$eval_csv" ]; then
     [ "$finished" = 2 ] || wait_for_learner "$env_steps"
     snapshot=$run/eval/checkpoint.rec
-    until step=$(learner_step) && cp "$run/ckpt/step-$(printf '%08d' "$step").rec" "$snapshot" 2>/dev/null; do sleep 0.2; done
+    until step=$(learner_step) && cp "$run/ckpt/step-$(printf '%08d' "$step").rec" "$snapshot" 2>/dev/null; do nap 0.2; done
     count_training_time
     # eval_point: the budget the evaluation stands for; out of budget, the steps it bought.
     point=$(( finished == 2 ? env_steps : finished ? ENV_STEPS : mark * EVAL_EVERY ))
@@ -319,7 +331,7 @@ while :; do
   fi
   [ "$finished" = 0 ] || break
   # A split run's learner: the actors (elsewhere) add chunks; look again in a while.
-  if [ "$ROLE" = learner ]; then check_learner; sleep 5; continue; fi
+  if [ "$ROLE" = learner ]; then check_learner; nap 5; continue; fi
 
   # Under a budget, the actor is paced by the learner (see out_of_budget).
   if [ "$CPU_BUDGET" -gt 0 ]; then

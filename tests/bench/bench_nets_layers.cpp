@@ -1,0 +1,145 @@
+// Where a learner step's time goes, layer by layer: each convolution and linear layer of the
+// `light` network (16 base channels, 10 input channels, a 16^3 grid; the dense head of the
+// last depth), as LibTorch runs it, timed alone with its input and output shapes of the real
+// network: the forward and the backward at the training batch (32), the Adam update of its
+// parameters, and the no-gradient forward at the batch sizes of acting (2: a single grid runs
+// as a pair) and of the targets (32 next states; 320 with K = 10 branches each), on 1 and 2
+// threads. For each: milliseconds, GFLOP/s (2 FLOPs a multiply-accumulate; the backward
+// computes input and weight gradients, twice the forward's) and the share of the machine's
+// fp32 peak measured on as many threads (machine_peak.hpp). Element-wise layers (LeakyReLU,
+// pooling, upsampling) are not listed: their cost is the difference between the sum here and
+// bench_nets_learner's step.
+// Options: --threads N (only N), --reps R (median of R, default 5), --batch B (default 32).
+#include <torch/torch.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "machine_peak.hpp"
+#include "nets/qattention_net.hpp"
+
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+struct Layer {
+  std::string name;
+  int in, out, kernel, voxels;  // kernel 0: a linear layer (voxels 1)
+  int64_t macs_per_sample() const {
+    const int64_t v = static_cast<int64_t>(voxels) * voxels * voxels;
+    return kernel == 0 ? static_cast<int64_t>(in) * out
+                       : v * in * out * static_cast<int64_t>(kernel) * kernel * kernel;
+  }
+};
+
+// light at 16 base channels (lib/nets/qattention_modules.cpp, LightNet): e0 at 16^3, e1 at
+// 8^3, e2 at 4^3, then back up; the dense head pools 4 levels of 16 + 32 + 64 + 16 channels.
+std::vector<Layer> light_layers() {
+  const int k = 16, c = 10;
+  return {{"input conv3", c, k, 3, 16},          {"down1.0 conv3", k, 2 * k, 3, 8},
+          {"down1.2 conv3", 2 * k, 2 * k, 3, 8}, {"down2.0 conv3", 2 * k, 4 * k, 3, 4},
+          {"down2.2 conv3", 4 * k, 4 * k, 3, 4}, {"lateral2 conv1", 4 * k, 2 * k, 1, 4},
+          {"up1 conv3", 2 * k, 2 * k, 3, 8},     {"lateral1 conv1", 2 * k, k, 1, 8},
+          {"up0 conv3", k, k, 3, 16},            {"q conv1", k, 1, 1, 16},
+          {"head.0 linear", 4 * 128, 128, 0, 1}, {"head.2 linear", 128, 128, 0, 1},
+          {"head.4 linear", 128, qte::nets::kRotationAxes * qte::nets::kRotationBins + qte::nets::kGripperActions, 0, 1}};
+}
+
+torch::nn::AnyModule make(const Layer& l) {
+  if (l.kernel == 0) return torch::nn::AnyModule(torch::nn::Linear(l.in, l.out));
+  return torch::nn::AnyModule(
+      torch::nn::Conv3d(torch::nn::Conv3dOptions(l.in, l.out, l.kernel).padding(l.kernel / 2)));
+}
+
+torch::Tensor input_for(const Layer& l, int batch) {
+  if (l.kernel == 0) return torch::randn({batch, l.in});
+  return torch::randn({batch, l.in, l.voxels, l.voxels, l.voxels});
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+template <typename F>
+double seconds(int reps, F&& f) {
+  f();  // warm-up: allocations, kernels chosen
+  std::vector<double> t;
+  for (int r = 0; r < reps; ++r) {
+    const auto t0 = Clock::now();
+    f();
+    t.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
+  }
+  return median(t);
+}
+
+struct Totals {
+  double forward = 0, backward = 0, adam = 0;
+};
+
+void run(int threads, int reps, int batch) {
+  qte::nets::set_torch_threads(threads);
+  const qte::bench::Peak peak = qte::bench::measure_fp32_peak(threads);
+  std::printf("\n%d thread(s): machine peak %.0f GFLOP/s fp32 (%s, measured); training batch %d\n", threads, peak.gflops,
+              peak.isa.c_str(), batch);
+  std::printf("%-15s %9s | %9s %7s %5s | %9s %7s %5s | %8s | forward no grad, ms at batch 2 / 32 / 320\n", "layer",
+              "MMAC/smp", "fwd ms", "GFLOP/s", "peak", "bwd ms", "GFLOP/s", "peak", "adam ms");
+  const auto share = [&](double gflops) { return 100 * gflops / peak.gflops; };
+  Totals total;
+  double total_gflop = 0;
+  for (const Layer& l : light_layers()) {
+    torch::nn::AnyModule m = make(l);
+    auto parameters = m.ptr()->parameters();
+    torch::optim::Adam adam(parameters, torch::optim::AdamOptions(1e-4));
+    const torch::Tensor x = input_for(l, batch).requires_grad_(true);
+    torch::Tensor y;
+    const double fwd = seconds(reps, [&] { y = m.forward(x); });
+    const torch::Tensor grad = torch::ones_like(y);
+    const double fwd_bwd = seconds(reps, [&] {
+      adam.zero_grad();
+      m.forward(x).backward(grad);
+    });
+    const double step = seconds(reps, [&] { adam.step(); });
+    std::vector<double> inference;
+    for (int b : {2, 32, 320}) {
+      torch::NoGradGuard no_grad;
+      const torch::Tensor xi = input_for(l, b);
+      inference.push_back(seconds(reps, [&] { m.forward(xi); }));
+    }
+    const double bwd = std::max(1e-9, fwd_bwd - fwd);
+    const double gflop = static_cast<double>(l.macs_per_sample()) * 2 * batch / 1e9;
+    std::printf("%-15s %9.2f | %9.2f %7.1f %4.0f%% | %9.2f %7.1f %4.0f%% | %8.3f | %.2f / %.2f / %.2f\n", l.name.c_str(),
+                l.macs_per_sample() / 1e6, fwd * 1e3, gflop / fwd, share(gflop / fwd), bwd * 1e3, 2 * gflop / bwd,
+                share(2 * gflop / bwd), step * 1e3, inference[0] * 1e3, inference[1] * 1e3, inference[2] * 1e3);
+    total.forward += fwd, total.backward += bwd, total.adam += step;
+    total_gflop += gflop;
+  }
+  std::printf("%-15s %9s | %9.2f %7.1f %4.0f%% | %9.2f %7.1f %4.0f%% | %8.3f |\n", "all layers", "",
+              total.forward * 1e3, total_gflop / total.forward, share(total_gflop / total.forward), total.backward * 1e3,
+              2 * total_gflop / total.backward, share(2 * total_gflop / total.backward), total.adam * 1e3);
+  std::printf("trunk layers, forward + backward: %.1f GFLOP/s, %.0f%% of peak (one depth's network, batch %d; the "
+              "learner step runs one per depth, plus the element-wise layers and the targets)\n",
+              3 * total_gflop / (total.forward + total.backward),
+              share(3 * total_gflop / (total.forward + total.backward)), batch);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  qte::nets::prepare_process_for_networks(argv);
+  int only_threads = 0, reps = 5, batch = 32;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    if (!std::strcmp(argv[i], "--threads")) only_threads = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--reps")) reps = std::max(1, std::atoi(argv[i + 1]));
+    else if (!std::strcmp(argv[i], "--batch")) batch = std::max(1, std::atoi(argv[i + 1]));
+  }
+  torch::manual_seed(0);
+  std::printf("light (16 base channels, 10 channels in, 16^3 grid): each layer timed alone, median of %d\n", reps);
+  for (int threads : {1, 2})
+    if (only_threads == 0 || only_threads == threads) run(threads, reps, batch);
+  return 0;
+}
