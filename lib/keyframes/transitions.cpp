@@ -100,6 +100,8 @@ void AgentEpisodeConverter::convert(const stream::Emit& emit) {
         for (int axis = 0; axis < 3; ++axis)
           if (index[axis] < 0 || index[axis] >= h.voxels())
             action.fail(prefix + ".index", "indices in 0.." + std::to_string(h.voxels() - 1) + " (--voxels)");
+        action.require_finite(prefix + ".bounds");
+        if (!(bounds[3] > 0)) action.fail(prefix + ".bounds", "a positive edge length (x, y, z, size in metres)");
         r.add(action.field(prefix + ".index"));
         r.add(action.field(prefix + ".bounds"));
       }
@@ -112,6 +114,8 @@ void AgentEpisodeConverter::convert(const stream::Emit& emit) {
                             action.has("ignore_collisions") ? action.scalar<uint8_t>("ignore_collisions") : 0);
       const auto pose = action.array<double>("pose");
       if (pose.size() != robot::kPoseValues) action.fail("pose", "float64 [7]");
+      action.require_finite("pose");
+      next.require_finite("reward");
       r.set<double>("target_pose", {robot::kPoseValues}, pose.data);
       r.set_scalar<float>("reward", next.scalar<float>("reward"));
       r.set_scalar<uint8_t>("terminal", next.scalar<uint8_t>("terminal"));
@@ -149,6 +153,10 @@ stream::Record frame_record(const stream::Record& obs, int64_t episode_key) {
   for (const char* name : {"joint_positions", "gripper_pose", "gripper_open", "gripper_opening_m", "episode_length", "task",
                            "variation"})
     if (obs.has(name)) frame.add(obs.field(name));
+  // Nothing non-finite reaches the replay: every real value kept is checked at its source
+  // (depth is stored as millimetres, where no return is 0).
+  for (const auto& field : frame.fields())
+    if (field.dtype() == stream::DType::f32 || field.dtype() == stream::DType::f64) obs.require_finite(field.name());
   return frame;
 }
 

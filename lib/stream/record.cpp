@@ -1,6 +1,7 @@
 #include "stream/record.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <limits>
 
@@ -108,6 +109,18 @@ const Field* Record::find(const std::string& name) const {
 void Record::fail(const std::string& field_name, const std::string& expected) const {
   throw StreamError(position, "'" + type_ + "' record, field '" + field_name + "': expected " +
                                   expected);
+}
+
+void Record::require_finite(const std::string& name) const {
+  const Field& f = field(name);
+  for (int64_t i = 0; i < f.element_count(); ++i) {
+    double x = 0;
+    if (f.dtype() == DType::f32) x = reinterpret_cast<const float*>(f.bytes())[i];
+    else if (f.dtype() == DType::f64) x = reinterpret_cast<const double*>(f.bytes())[i];
+    else fail(name, "float32 or float64, got " + std::string(dtype_name(f.dtype())));
+    if (!std::isfinite(x))
+      fail(name, "finite values, element " + std::to_string(i) + " is " + (std::isnan(x) ? "nan" : x > 0 ? "inf" : "-inf"));
+  }
 }
 
 const Field& Record::field(const std::string& name) const {

@@ -121,6 +121,9 @@ class Record {
   std::string string(const std::string& name) const;
 
   [[noreturn]] void fail(const std::string& field_name, const std::string& expected) const;
+  // Fails (naming this record and the field) unless every element of the float32 or float64
+  // field is finite: for values written on (poses, bounds, rewards, camera matrices).
+  void require_finite(const std::string& name) const;
 
   // The X of every field named X<suffix>, in field order: e.g. the cameras of an observation,
   // prefixes(".rgb") -> {"front", "wrist"}.
