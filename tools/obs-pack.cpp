@@ -4,11 +4,13 @@
 
 #include <cctype>
 #include <cstring>
+#include <iostream>
 
 #include "camera_recordings/camera_recordings.hpp"
 #include "cli/command.hpp"
 #include "point_clouds/pcd_file.hpp"
 #include "stream/writer.hpp"
+#include "voxels/observation_cloud.hpp"
 #include "world/scene_layout.hpp"
 
 using namespace qte;
@@ -108,9 +110,10 @@ static camera_recordings::CameraSetup camera_setup(const cli::Arguments& args) {
   if (!stream::is_valid_field_name(camera.name + ".rgb")) throw UsageError("--camera: not a usable field name");
   if (args.has("intrinsics")) {
     const auto k = args.reals("intrinsics", 4);
-    if (!(k[0] > 0 && k[1] > 0)) throw UsageError("--intrinsics: focal lengths must be positive");
-    Eigen::Matrix3d m;
+    Eigen::Matrix<double, 3, 3, Eigen::RowMajor> m;
     m << k[0], 0, k[2], 0, k[1], k[3], 0, 0, 1;
+    const std::string problem = voxels::intrinsics_problem(m.data());
+    if (!problem.empty()) throw UsageError("--intrinsics: expected " + problem);
     camera.intrinsics = m;
   }
   if (args.has("camera-pose") == args.has("extrinsics")) throw UsageError("give the camera's pose: one of --camera-pose and --extrinsics");
@@ -123,10 +126,8 @@ static camera_recordings::CameraSetup camera_setup(const cli::Arguments& args) {
     const auto e = args.reals("extrinsics", 16);
     for (int r = 0; r < 4; ++r)
       for (int c = 0; c < 4; ++c) camera.camera_to_world.matrix()(r, c) = e[4 * r + c];
-    const Eigen::Matrix3d rotation = camera.camera_to_world.linear();
-    if (!(rotation.transpose() * rotation).isApprox(Eigen::Matrix3d::Identity(), 1e-4) ||
-        !camera.camera_to_world.matrix().row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1)))
-      throw UsageError("--extrinsics: not a rigid transform (rotation, translation, last row 0 0 0 1)");
+    const std::string problem = voxels::extrinsics_problem(e.data());
+    if (!problem.empty()) throw UsageError("--extrinsics: expected " + problem);
   }
   camera.depth_unit_m = args.real("depth-unit", 1e-6, 1.0);
   camera.store_points = !args.flag("no-points");
@@ -147,7 +148,7 @@ static void run(const cli::Arguments& args) {
   if (args.has("joints")) states = camera_recordings::read_joint_csv(args.text("joints"), robot);
 
   stream::RecordWriter writer(args.text("output"));
-  int64_t written = 0;
+  int64_t written = 0, blind = 0;
   for (int64_t index = start; count < 0 || written < count; ++index) {
     const std::string first = frame_path(args.text(images ? "rgb" : "pcd"), index);
     if (!exists(first)) {
@@ -175,11 +176,18 @@ static void run(const cli::Arguments& args) {
       obs.set_scalar<double>("gripper_opening_m", robot.max_finger_opening_m());
     }
     camera_recordings::add_episode_fields(obs, static_cast<int>(written), episode_length, args.text("task"));
+    const voxels::ObservationCloud cloud = voxels::observation_cloud(obs);
+    if (voxels::points_inside(cloud.view(), voxels::GridBounds{}) == 0) blind += 1;
     writer.write(obs);
     written += 1;
   }
   if (written == 0) throw Error(frame_path(args.text(images ? "rgb" : "pcd"), start) + ": no such frame");
   writer.close();
+  // Not an error here (other bounds may suit), but qte-select and qattn-train refuse such frames.
+  if (blind > 0)
+    std::cerr << "obs-pack: warning: " << blind << " of " << written
+              << " frames have no point inside the default scene bounds -0.3,-0.5,0.6,1.0: check the camera pose "
+                 "(--camera-pose, --extrinsics), --intrinsics and --depth-unit\n";
 }
 
 int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }

@@ -157,6 +157,7 @@ stream::Record frame_record(const stream::Record& obs, int64_t episode_key) {
   // (depth is stored as millimetres, where no return is 0).
   for (const auto& field : frame.fields())
     if (field.dtype() == stream::DType::f32 || field.dtype() == stream::DType::f64) obs.require_finite(field.name());
+  for (const std::string& camera : obs.prefixes(".extrinsics")) voxels::check_camera_matrices(obs, camera);
   return frame;
 }
 

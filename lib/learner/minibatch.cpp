@@ -55,6 +55,7 @@ Minibatch assemble_minibatch(const replay::ReplayBuffer& replay, const replay::S
     const stream::Record& t = replay.transition(index);  // checked when read (check_transition)
     const stream::Record& frame = replay.frame_of(index);
     const voxels::ObservationCloud cloud = voxels::observation_cloud(frame);
+    voxels::require_points_in_scene(frame, cloud, h.scene);  // never learn from an empty scene
     for (int d = 0; d < depths; ++d) {
       const voxels::GridBounds g = voxels::bounds_field(t, depth_field(d, "bounds"), v);
       const auto index3 = t.array<int32_t>(depth_field(d, "index"));
@@ -88,6 +89,7 @@ Minibatch assemble_minibatch(const replay::ReplayBuffer& replay, const replay::S
     const stream::Record& next = replay.next_frame_of(last);
     const int32_t next_step = replay.transition(last).scalar<int32_t>("step") + 1;
     b.next_clouds.push_back(voxels::observation_cloud(next));
+    voxels::require_points_in_scene(next, b.next_clouds.back(), h.scene);
     b.next_proprio.push_back(qattention::proprio_of(next, next_step));
     b.next_state.push_back(next_states.emplace(std::pair{&next, next_step}, next_states.size()).first->second);
   }

@@ -41,6 +41,7 @@ void SelectStage::handle(const stream::Record& record, const stream::Emit& emit)
   // The action's pictures read `observed` later: it must outlive the action.
   const voxels::ObservationCloud observed =
       voxels::observation_cloud(options_.prepare ? options_.prepare(record) : record);
+  voxels::require_points_in_scene(record, observed, options_.hierarchy.scene);  // never act on an empty scene
   Action action = act_on(record, observed, step);  // not const: its pictures compute their grids lazily
   if (!options_.png_dir.empty()) save_q_pictures(options_.png_dir, actions_, action);
   emit(action_record(action.choice, options_.ignore_collisions, options_.branching.k, action.explored,

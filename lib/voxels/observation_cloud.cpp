@@ -37,6 +37,62 @@ void points_from_depth(const float* depth_m, int width, int height, const double
     }
 }
 
+std::string intrinsics_problem(const double* k) {
+  for (int i = 0; i < 9; ++i)
+    if (!std::isfinite(k[i])) return "finite values";
+  if (!(k[0] > 0 && k[4] > 0)) return "positive focal lengths fx, fy (elements [0, 0] and [1, 1])";
+  if (k[6] != 0 || k[7] != 0 || k[8] != 1) return "a pinhole matrix [[fx, s, cx], [0, fy, cy], [0, 0, 1]]";
+  return "";
+}
+
+std::string extrinsics_problem(const double* e) {
+  for (int i = 0; i < 16; ++i)
+    if (!std::isfinite(e[i])) return "finite values";
+  const Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> m(e);
+  const Eigen::Matrix3d r = m.topLeftCorner<3, 3>();
+  if (!(r.transpose() * r - Eigen::Matrix3d::Identity()).isZero(1e-3) || std::abs(r.determinant() - 1) > 1e-3 ||
+      !m.row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1)))
+    return "a camera-to-world pose: a proper rotation (orthonormal, determinant +1), a translation, last row 0 0 0 1";
+  return "";
+}
+
+void check_camera_matrices(const stream::Record& obs, const std::string& camera) {
+  if (obs.has(camera + ".intrinsics")) {
+    const auto k = obs.array<double>(camera + ".intrinsics");
+    if (k.size() != 9) obs.fail(camera + ".intrinsics", "float64 [3, 3]");
+    const std::string problem = intrinsics_problem(k.data);
+    if (!problem.empty()) obs.fail(camera + ".intrinsics", problem);
+  }
+  const auto e = obs.array<double>(camera + ".extrinsics");
+  if (e.size() != 16) obs.fail(camera + ".extrinsics", "float64 [4, 4]");
+  const std::string problem = extrinsics_problem(e.data);
+  if (!problem.empty()) obs.fail(camera + ".extrinsics", problem);
+}
+
+std::size_t points_inside(const PointCloud& cloud, const GridBounds& bounds) {
+  const Eigen::Vector3d lo = bounds.min_corner, hi = bounds.max_corner();
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < cloud.count; ++i) {
+    const float* p = cloud.xyz + 3 * i;
+    n += p[0] >= lo.x() && p[0] < hi.x() && p[1] >= lo.y() && p[1] < hi.y() && p[2] >= lo.z() && p[2] < hi.z();
+  }
+  return n;
+}
+
+void require_points_in_scene(const stream::Record& obs, const ObservationCloud& cloud, const GridBounds& scene) {
+  const PointCloud view = cloud.view();
+  if (points_inside(view, scene) > 0) return;
+  std::size_t seen = 0;
+  for (std::size_t i = 0; i < view.count; ++i) seen += std::isfinite(view.xyz[3 * i]);
+  const Eigen::Vector3d c = scene.min_corner;
+  throw StreamError(obs.position, "'" + obs.type() + "' record: none of its " + std::to_string(seen) +
+                                      " points lies inside the scene bounds " + std::to_string(c.x()) + "," +
+                                      std::to_string(c.y()) + "," + std::to_string(c.z()) + "," +
+                                      std::to_string(scene.size_m) +
+                                      ": nothing seen; check the cameras' extrinsics (camera-to-world pose) and "
+                                      "intrinsics, the depth units, and --bounds");
+}
+
 namespace {
 
 // Appends one camera's pixels to xyz/rgb: its stored points, or points rebuilt from its depth.
@@ -51,6 +107,7 @@ std::pair<int, int> append_camera(const stream::Record& obs, const std::string& 
   rgb_out.insert(rgb_out.end(), rgb.begin(), rgb.end());
   xyz.resize(3 * (at + n));
   float* out = xyz.data() + 3 * at;
+  if (obs.has(camera + ".extrinsics")) check_camera_matrices(obs, camera);
   if (obs.has(camera + ".points")) {
     const auto points = obs.array<float>(camera + ".points");
     if (points.shape != stream::Shape{h, w, 3}) obs.fail(camera + ".points", "float32 [H, W, 3] like " + name);
@@ -67,10 +124,10 @@ std::pair<int, int> append_camera(const stream::Record& obs, const std::string& 
     if (d.shape != stream::Shape{h, w}) obs.fail(camera + ".depth", "float32 [H, W] like " + name);
     std::copy(d.begin(), d.end(), depth.begin());
   }
+  check_camera_matrices(obs, camera);  // depth needs both
+  if (!obs.has(camera + ".intrinsics")) obs.fail(camera + ".intrinsics", "float64 [3, 3] (depth needs it)");
   const auto k = obs.array<double>(camera + ".intrinsics");
   const auto e = obs.array<double>(camera + ".extrinsics");
-  if (k.size() != 9) obs.fail(camera + ".intrinsics", "float64 [3, 3]");
-  if (e.size() != 16) obs.fail(camera + ".extrinsics", "float64 [4, 4]");
   points_from_depth(depth.data(), w, h, k.data, e.data, out);
   return {h, w};
 }
