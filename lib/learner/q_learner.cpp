@@ -136,10 +136,16 @@ void QLearner::save(const std::string& path, const stream::Record& extra) const 
 }
 
 stream::Record QLearner::load(const std::string& path) {
+  // Every record is read (and so checked); each is found by its role, not its place.
   stream::RecordReader reader(path);
-  auto online = reader.next();
-  auto target = reader.next();
-  auto extra = reader.next();
+  std::optional<stream::Record> online, target, extra;
+  while (auto record = reader.next()) {
+    std::optional<stream::Record>& slot = record->type() != "checkpoint" ? extra
+                                          : record->has("role") && record->string("role") == "target" ? target
+                                                                                                      : online;
+    if (slot) throw StreamError(record->position, "a second '" + record->type() + "' record of this role: expected a learner checkpoint (online 'checkpoint', target 'checkpoint', the learner's state)");
+    slot = std::move(record);
+  }
   if (!online || !target || !extra)
     throw StreamError({path, reader.records_read(), reader.byte_offset()}, "expected a learner checkpoint (online 'checkpoint', target 'checkpoint', "
                                          "and the learner's state), the file ends early");

@@ -136,18 +136,25 @@ CheckpointConfig checkpoint_config(const stream::Record& record) {
   return config;
 }
 
-namespace {
-
-stream::Record read_first_record(const std::string& path) {
+stream::Record read_online_checkpoint(const std::string& path) {
   stream::RecordReader reader(path);
-  std::optional<stream::Record> record = reader.next();
-  if (!record) throw StreamError({path, 0, 0}, "expected a 'checkpoint' record, the file is empty");
-  return std::move(*record);
+  std::optional<stream::Record> online;
+  while (std::optional<stream::Record> record = reader.next()) {
+    if (record->type() != "checkpoint" || record->has("role")) continue;
+    if (online)
+      throw StreamError(record->position, "a second online 'checkpoint' record (the first is record " +
+                                              std::to_string(online->position.record_index) +
+                                              "): expected one, and target networks with role 'target'");
+    online = std::move(record);
+  }
+  if (!online)
+    throw StreamError({path, reader.records_read(), reader.byte_offset()},
+                      "expected a 'checkpoint' record of the online networks (without a 'role'), found none in " +
+                          std::to_string(reader.records_read()) + " records");
+  return std::move(*online);
 }
 
-}  // namespace
-
-CheckpointConfig read_checkpoint_config(const std::string& path) { return checkpoint_config(read_first_record(path)); }
+CheckpointConfig read_checkpoint_config(const std::string& path) { return checkpoint_config(read_online_checkpoint(path)); }
 
 int64_t load_checkpoint_record(const stream::Record& record, std::vector<QAttentionNet>& nets,
                                torch::optim::Adam* adam) {
@@ -237,7 +244,7 @@ int64_t load_checkpoint_record(const stream::Record& record, std::vector<QAttent
 }
 
 int64_t load_checkpoint(const std::string& path, std::vector<QAttentionNet>& nets, torch::optim::Adam* adam) {
-  return load_checkpoint_record(read_first_record(path), nets, adam);
+  return load_checkpoint_record(read_online_checkpoint(path), nets, adam);
 }
 
 }  // namespace qte::nets

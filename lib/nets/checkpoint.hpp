@@ -33,6 +33,11 @@ void save_checkpoint(const std::string& path, const std::vector<QAttentionNet>& 
 
 CheckpointConfig checkpoint_config(const stream::Record& record);
 CheckpointConfig read_checkpoint_config(const std::string& path);
+// The online networks' 'checkpoint' record of the file at `path`, found by role (a 'checkpoint'
+// record without a 'role' field; the target networks' has role "target"), after every record
+// of the file has been read and checked, so damage anywhere in it is an error. Throws
+// StreamError unless there is exactly one such record.
+stream::Record read_online_checkpoint(const std::string& path);
 
 // Loads weights into `nets` (and, when `adam` is given, its state for their parameters: none
 // when the checkpoint has none) and returns the step. Everything is checked before anything

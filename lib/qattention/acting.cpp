@@ -16,13 +16,6 @@ namespace qte::qattention {
 
 namespace {
 
-stream::Record checkpoint_record(const std::string& path) {
-  stream::RecordReader reader(path);
-  auto record = reader.next();
-  if (!record) throw StreamError({path, 0, 0}, "expected a 'checkpoint' record, the file is empty");
-  return std::move(*record);
-}
-
 constexpr int kOccupancyChannel = voxels::kChannels - 1;  // 1 when the voxel holds a point
 
 // The value of a path as the tree values its best path: from the last depth up, each depth
@@ -48,7 +41,7 @@ CheckpointNetworks::FileVersion CheckpointNetworks::version_of(const std::string
 
 CheckpointNetworks::CheckpointNetworks(const std::string& path) : path_(path) {
   version_ = version_of(path_);
-  const stream::Record record = checkpoint_record(path_);
+  const stream::Record record = nets::read_online_checkpoint(path_);
   config_ = nets::checkpoint_config(record);
   if (config_.net.channels != voxels::kChannels)
     throw Error(path_ + ": the networks take " + std::to_string(config_.net.channels) +
@@ -64,7 +57,7 @@ CheckpointNetworks::CheckpointNetworks(const std::string& path) : path_(path) {
 bool CheckpointNetworks::reload_if_changed() {
   const FileVersion now = version_of(path_);
   if (now == version_) return false;
-  step_ = nets::load_checkpoint_record(checkpoint_record(path_), nets_, nullptr);  // checks the configuration
+  step_ = nets::load_checkpoint_record(nets::read_online_checkpoint(path_), nets_, nullptr);  // checks the configuration
   version_ = now;
   return true;
 }
