@@ -62,7 +62,7 @@ def section(directory, images):
         out.append("No runs are committed yet.\n")
     else:
         runs = results_table.final_rows(csvs)
-        out.append(f"{len(csvs)} runs (`examples/results/{name}/`). Final success on the held-out scenes, per method "
+        out.append(f"{len(csvs)} run{'s' if len(csvs) != 1 else ''} (`examples/results/{name}/`). Final success on the held-out scenes, per method "
                    "(each run's last evaluation; Wilson 95% interval per run):\n")
         out.append(markdown([results_table.summary(task, label, rows) for (task, label), rows in sorted(runs.items())]))
         paired = results_table.paired(runs, BASELINE)
