@@ -7,13 +7,15 @@ export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-PASSIVE}
 
 cp "$src/tests/data/reach_target_demo.rec" "$tmp/demos.rec"
 keyframe "$tmp/demos.rec" > "$tmp/transitions.rec" 2>/dev/null || fail "keyframe"
-qattn-train --steps 0 --seed 1 --checkpoint-dir "$tmp/ckpt" "$tmp/transitions.rec" 2>/dev/null || fail "qattn-train --steps 0"
+# Three steps: the target networks (soft-updated) differ from the online ones by then.
+qattn-train --steps 3 --batch 4 --start-after 0 --seed 1 --checkpoint-dir "$tmp/ckpt" "$tmp/transitions.rec" 2>/dev/null \
+  || fail "qattn-train --steps 3"
 ckpt=$tmp/ckpt/latest.rec
 stream-cat --type obs --head 2 "$tmp/demos.rec" > "$tmp/obs.rec"
 qte-select --checkpoint "$ckpt" --seed 3 "$tmp/obs.rec" > "$tmp/a.rec" 2>"$tmp/err" || fail "qte-select: $(cat "$tmp/err")"
 
-# Target networks first, the online ones last: the same actions. (At step 0 both networks are
-# equal, so this shows only that the order is accepted; the damage below fails on reading by position.)
+# Target networks first, the online ones last: the same actions and Q values (a reader taking
+# the first record would act with the target networks: other bytes).
 { stream-cat --where role=target "$ckpt"; stream-cat --exclude checkpoint "$ckpt"; stream-cat --head 1 "$ckpt"; } > "$tmp/reordered.rec"
 [ "$(stream-dump --summary "$tmp/reordered.rec" | cut -f2)" = "$(stream-dump --summary "$ckpt" | cut -f2)" ] || fail "reordering lost records"
 qte-select --checkpoint "$tmp/reordered.rec" --seed 3 "$tmp/obs.rec" > "$tmp/b.rec" 2>"$tmp/err" || fail "reordered checkpoint: $(cat "$tmp/err")"
