@@ -60,16 +60,8 @@ static cli::Usage usage() {
 }
 
 static void run(const cli::Arguments& args) {
-  const std::vector<std::string> files = args.inputs();
-  std::vector<report::Episode> episodes;
-  for (const std::string& file : files) {
-    const auto more = report::read_episodes(file, [](const std::string& line) {
-      std::cerr << "episode-stats: " << line << "\n";
-    });
-    episodes.insert(episodes.end(), more.begin(), more.end());
-  }
-
-  // The extra columns: --label first, then every --column in order.
+  // The extra columns: --label first, then every --column in order (checked before any input
+  // is read: a usage error must not wait for the end of a pipe).
   std::string extra_names, extra_values;
   if (args.has("label")) {
     extra_names += "label,";
@@ -81,6 +73,15 @@ static void run(const cli::Arguments& args) {
       throw UsageError("--column: expected NAME=VALUE, got '" + column + "'");
     extra_names += report::csv_cell(column.substr(0, equals)) + ",";
     extra_values += report::csv_cell(column.substr(equals + 1)) + ",";
+  }
+
+  const std::vector<std::string> files = args.inputs();
+  std::vector<report::Episode> episodes;
+  for (const std::string& file : files) {
+    const auto more = report::read_episodes(file, [](const std::string& line) {
+      std::cerr << "episode-stats: " << line << "\n";
+    });
+    episodes.insert(episodes.end(), more.begin(), more.end());
   }
   const bool header = !args.flag("no-header");
   std::string out;

@@ -63,6 +63,10 @@ out=$(episode-stats --label qte --column seed=2 --column step=5000 "$tmp/packed.
 { episode-stats --label one "$tmp/run.rec"; episode-stats --label two --no-header "$tmp/packed.rec"; } > "$tmp/both.csv"
 [ "$(cut -d, -f1,2 "$tmp/both.csv" | tr '\n' ' ')" = "label,episodes one,3 two,7 " ] || fail "appended rows"
 episode-stats --column novalue "$tmp/run.rec" >/dev/null 2>&1; [ $? = 2 ] || fail "--column without = accepted"
+# ... and said at once, not after the input has ended (here: a pipe open for 20 s).
+start=$(date +%s)
+episode-stats --column novalue < <(sleep 20) >/dev/null 2>&1; rc=$?
+[ $rc = 2 ] && [ $(( $(date +%s) - start )) -lt 10 ] || fail "--column usage error after the input: exit $rc, $(( $(date +%s) - start )) s"
 
 # An unfinished last episode (a reset's observation, no terminal one) is left out and reported;
 # so is one cut short by a new reset.
