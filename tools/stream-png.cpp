@@ -1,6 +1,7 @@
 // stream-png: save the camera images of a stream as PNG files, or an episode as a video.
 
 #include <cstdio>
+#include <filesystem>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -82,6 +83,8 @@ static void run(const cli::Arguments& args) {
   const std::vector<std::string> files = args.inputs();
   const std::string dir = args.text("dir"), type = args.text("type");
   const int64_t every = args.integer("every", 1, 1000000000);
+  if (args.has("attention") && !std::filesystem::is_directory(args.text("attention")))
+    throw UsageError("--attention " + args.text("attention") + ": no such directory (qte-select --png DIR writes the pictures)");
   std::unique_ptr<video::EpisodeVideo> video;
   if (args.has("video")) {
     if (type != "obs") throw UsageError("--video shows observations: --type obs");

@@ -168,6 +168,10 @@ first_obs | qte-select --checkpoint "$ckpt" --ignore-collisions --png "$tmp/png"
 # table and sample entry read here; the decoders' read-back is in tests/unit/video.
 qte-select --checkpoint "$ckpt" --png "$tmp/attention" "$tmp/episodes.rec" > /dev/null || fail "qte-select --png on episodes"
 stream-png --video "$tmp/episodes.mp4" --fps 4 --attention "$tmp/attention" "$tmp/episodes.rec" || fail "stream-png --video"
+# A directory of pictures that is not there is an error, not a video without them.
+err=$(stream-png --video "$tmp/none.mp4" --fps 4 --attention "$tmp/no-such-dir" "$tmp/episodes.rec" 2>&1); rc=$?
+[ $rc = 2 ] && grep -q "no-such-dir: no such directory" <<<"$err" && [ ! -e "$tmp/none.mp4" ] \
+  || fail "--attention with a missing directory: exit $rc, '$err'"
 stream-png --video "$tmp/episodes.gif" --height 64 "$tmp/episodes.rec" || fail "stream-png --video .gif"
 observations=$(stream-dump --summary --type obs "$tmp/episodes.rec" | cut -f2 | cut -d' ' -f1)
 $py - "$tmp/episodes.mp4" "$tmp/episodes.gif" "$observations" <<'EOF2' || fail "episode video"
