@@ -158,7 +158,11 @@ void write_file_atomically(const std::string& path, const void* data, std::size_
 }
 
 void make_output_directory(const std::string& path) {
-  if (::mkdir(path.c_str(), 0755) != 0 && errno != EEXIST) throw_system_error("cannot create directory " + path);
+  if (::mkdir(path.c_str(), 0755) == 0) return;
+  if (errno != EEXIST) throw_system_error("cannot create directory " + path);
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0 || !S_ISDIR(st.st_mode))
+    throw Error(path + ": exists and is not a directory (expected an output directory)");
 }
 
 }  // namespace qte

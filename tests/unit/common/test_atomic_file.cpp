@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <thread>
@@ -113,4 +114,19 @@ TEST(AtomicFile, StaleTemporariesOfDeadWritersAreRemoved) {
   EXPECT_FALSE(exists(dir + "/step-00000003.rec.tmp." + dead));
   EXPECT_TRUE(exists(dir + "/out.rec.tmp." + alive));
   EXPECT_TRUE(exists(dir + "/notes.tmp.txt"));
+}
+
+// An output directory that exists is used; a file in its place is an error naming it.
+TEST(OutputDirectory, MadeOrReusedButNeverAFile) {
+  const std::string dir = temp_dir();
+  make_output_directory(dir + "/out");
+  make_output_directory(dir + "/out");  // again: already there
+  EXPECT_TRUE(std::filesystem::is_directory(dir + "/out"));
+  std::ofstream(dir + "/file").put('x');
+  try {
+    make_output_directory(dir + "/file");
+    FAIL() << "a file taken for a directory";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(dir + "/file: exists and is not a directory"), std::string::npos) << e.what();
+  }
 }
