@@ -201,8 +201,8 @@ def paired(runs, baseline):
             "mean_success": f"{statistics.mean(float(a['success_rate']) for a, _ in pairs):.3f}",
             "baseline_mean_success": f"{statistics.mean(float(b['success_rate']) for _, b in pairs):.3f}",
             "mean_difference": f"{mean:+.3f}",
-            "ci95_low": f"{mean - half:+.3f}",
-            "ci95_high": f"{mean + half:+.3f}",
+            "ci95_low": f"{mean - half:+.3f}" if len(d) > 1 else "",  # no interval from one pair
+            "ci95_high": f"{mean + half:+.3f}" if len(d) > 1 else "",
             "sign_flip_p": f"{sign_flip_p(d):.4f}",
             "per_seed": " ".join(f"s{a['seed']}:{x:+.2f}" for (a, _), x in zip(pairs, d)),
         })

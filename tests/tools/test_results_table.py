@@ -132,6 +132,7 @@ def main():
         pairs = rows_of(run("--paired", "c2farm-k1-t0", *paths).stdout)
         assert [(r["task"], r["label"], r["pairs"], r["mean_difference"]) for r in pairs] == [
             ("lift_numbered_block", "qte-k10-t10", "1", f"{(19 - 13) / 50:+.3f}")], pairs
+        assert pairs[0]["ci95_low"] == pairs[0]["ci95_high"] == "", pairs  # no interval from one pair
         mine = []
         for seed, (base, qte) in enumerate([(20, 24), (30, 32), (10, 16), (40, 38), (25, 30)]):
             mine.append(write_run(d, f"reach_prism_c2farm-k1-t0-seed{seed}.csv", "c2farm-k1-t0", seed, [(base, 9)]))
