@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
-"""What makes a task coarsely ambiguous, by numbers: the objects on the table in the first
-observation of a demonstration, the target being the one the expert first closes the gripper
-over (or, if it never does, the one its last pose is over).
+"""What makes a task coarsely ambiguous, by numbers: the objects in the first observation of a
+demonstration, the target being the one the task names (in streams without objects.*, the one
+the expert first closes the gripper over or, if it never does, the one its last pose is over).
 
-    ambiguity.py centres DEMO.rec               one line per object, x,y,z (target first)
+    ambiguity.py centres DEMO.rec               one line per object, x,y,z (target first,
+                                                then its lookalikes)
     ambiguity.py places DEMO.rec                where the expert first releases what it holds
                                                 (the target), then 4 cm along x and 4 cm along
                                                 x and y from there (setup_checkers' neighbours)
@@ -11,19 +12,75 @@ over (or, if it never does, the one its last pose is over).
                                                 depth-0 voxel of each object (its 10 channels)
                                                 and the top view of its depth-1 grid
 
-Objects are the points 3 mm to 10 cm above the table top inside the task region, grouped by
-distance (5 cm); the table top is at 0.752 m (DESIGN's layout). Run with Debian's python3."""
+Objects are the task's own, with their roles, where the observations carry them (demo-record
+--objects, as ambiguity.sh records): the target first, then its lookalikes (the distractors),
+each at its bounding box's centre. In streams without them, objects are the points 3 mm to
+10 cm above the table top inside the task region, grouped by distance (5 cm), and the target
+is the one the expert goes for; the table top is at 0.752 m (DESIGN's layout).
+
+The rule for where an action went, shared with failure_reasons.py and depth_decisions.py
+(object_at): a point lies on an object when, in the object's frame, it is inside the object's
+bounding box grown by a margin on every side and reaching `ABOVE_M` (10 cm) higher — poses
+above an object, from which it is grasped or reached, count as on it. Among several, targets
+and distractors come before other objects (zones, bins, boards), then the nearest in plan view
+to the box's centre. Run with Debian's python3."""
 import sys
 
 import numpy as np
 
 sys.path.insert(0, __file__.rsplit("/", 2)[0] + "/lib/python")  # or installed: make install
-from qte_stream import read_records  # noqa: E402
+from qte_stream import read_records, scene_objects  # noqa: E402
 
 TABLE_Z, REGION = 0.752, ((-0.05, 0.35), (-0.3, 0.3))
+ABOVE_M = 0.1
+
+
+def rotation(pose):
+    """The rotation matrix of a pose's quaternion (x, y, z, w)."""
+    x, y, z, w = np.asarray(pose[3:7], np.float64) / np.linalg.norm(pose[3:7])
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+
+
+def box_centre(obj):
+    """An object's bounding-box centre in the world frame."""
+    return np.asarray(obj.pose[:3]) + rotation(obj.pose) @ ((np.asarray(obj.box_min) + np.asarray(obj.box_max)) / 2)
+
+
+def lies_on(obj, point, margin_m):
+    """The point (world frame) inside the object's box grown by margin_m, and ABOVE_M upwards."""
+    local = rotation(obj.pose).T @ (np.asarray(point[:3], np.float64) - np.asarray(obj.pose[:3]))
+    low = np.asarray(obj.box_min) - margin_m
+    high = np.asarray(obj.box_max) + margin_m + np.array([0, 0, ABOVE_M])
+    return bool(np.all(local >= low) and np.all(local <= high))
+
+
+def object_at(found, point, margin_m):
+    """The SceneObject the point lies on (see the module's text), or None."""
+    on = [o for o in found if lies_on(o, point, margin_m)]
+    if not on:
+        return None
+    rank = {"target": 0, "distractor": 0}
+    return min(on, key=lambda o: (rank.get(o.role, 1), np.linalg.norm(box_centre(o)[:2] - np.asarray(point[:2]))))
+
+
+def task_objects(obs):
+    """The observation's targets and distractors (SceneObjects), the first target first, then
+    the distractors, then the other targets; None for a stream without objects.*."""
+    found = scene_objects(obs)
+    if found is None:
+        return None
+    targets = [o for o in found if o.role == "target"]
+    return targets[:1] + [o for o in found if o.role == "distractor"] + targets[1:]
 
 
 def objects(obs):
+    """Object centres of an observation: its task objects' (task_objects) where it carries them,
+    else groups of points above the table."""
+    found = task_objects(obs)
+    if found is not None:
+        return [box_centre(o) for o in found]
     points = np.asarray(obs.fields["front.points"]).reshape(-1, 3)
     points = points[np.isfinite(points).all(1)]
     keep = ((points[:, 2] > TABLE_Z + 0.003) & (points[:, 2] < TABLE_Z + 0.1) &
@@ -43,6 +100,12 @@ def objects(obs):
 
 def centres(path):
     records = [r for r in read_records(path) if r.type == "obs"]
+    found = task_objects(records[0])
+    if found is not None:  # the target, then its lookalikes
+        for o in [found[0]] + [o for o in found if o.role == "distractor"]:
+            c = box_centre(o)
+            print(f"{c[0]:.4f},{c[1]:.4f},{c[2]:.4f}")
+        return
     found = objects(records[0])
     closed = [r for r in records if not int(np.asarray(r.fields["gripper_open"]).reshape(-1)[0])]
     over = np.asarray((closed or records[-1:])[0].fields["gripper_pose"])[:2]

@@ -10,7 +10,7 @@ set -euo pipefail
 task=$1 seed=${2:-1} image=${3:-256x256} around=${4:-centres}
 here=$(cd "$(dirname "$0")" && pwd)
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-demo-record --task "$task" --episodes 1 --seed "$seed" --image-size "$image" --output "$tmp/demo.rec" 2>/dev/null
+demo-record --task "$task" --episodes 1 --seed "$seed" --image-size "$image" --objects --output "$tmp/demo.rec" 2>/dev/null
 centres=$(/usr/bin/python3 "$here/ambiguity.py" "$around" "$tmp/demo.rec")
 args=(); for c in $centres; do args+=(--centre "$c"); done
 stream-cat --type obs --head 1 "$tmp/demo.rec" | voxelize "${args[@]}" --png "$tmp/png" --output "$tmp/voxels.rec"

@@ -5,16 +5,20 @@
 
 EXPERTS.rec: the expert's demonstrations of the same scenes (demo-record --scenes eval with the
 evaluation's seed); AGENT.rec: the agent's greedy episodes of them (sim-step, qte-select,
-plan-path). In each scene the objects are found in the first observation (ambiguity.py's
-rule); the target is the object the expert went for and the agent's is the one nearest where
-it went: the first pose at which the gripper closes, or else the last pose it chose. Each
-episode is then one of
+plan-path). Where the agent went is the first pose at which the gripper closes, or else the
+last pose it chose. With the objects the simulator wrote (sim-step --objects, as
+failure_reasons.sh runs it), the object it went for is the target or distractor that pose lies
+on (ambiguity.py's object_at: within 2 cm of the object's bounding box or up to 10 cm above
+it), as of the episode's first observation. In streams without them the objects are found in
+the first observation's points (ambiguity.py's rule), the target is the object the expert
+went for and the agent's the one nearest where it went, within 4 cm. Each episode is then one of
     success            the task was solved
-    distractor         not solved, and the agent went for another object than the target:
-                       what coarse ambiguity predicts
+    distractor         not solved, and the agent went for another object than the target (a
+                       lookalike): what coarse ambiguity predicts
     target             not solved although it went for the target (a wrong height, rotation
                        or gripper command, or a failed action)
-    elsewhere          nearer no object than 4 cm
+    elsewhere          at no object (with the simulator's objects: at no target or
+                       distractor)
 and the counts are printed as CSV: label, seed, episodes, the four kinds, and failed_actions (the
 episodes that ended on a failed action: the planner's or the simulator's reason, any kind).
 --episodes prints one line per episode on stderr: kind, distance to the nearest object, the
@@ -28,9 +32,10 @@ import numpy as np
 
 sys.path.insert(0, __file__.rsplit("/", 2)[0] + "/lib/python")  # or installed: make install
 from qte_stream import read_records  # noqa: E402
-from ambiguity import objects  # noqa: E402  (one rule for what an object is)
+from ambiguity import box_centre, object_at, objects, task_objects  # noqa: E402  (one rule for what an object is)
 
-NEAR_M = 0.04
+NEAR_M = 0.04  # from a group of points (streams without objects)
+MARGIN_M = 0.02  # around an object's bounding box (with the simulator's objects)
 
 
 def scalar(record, name, default=None):
@@ -66,10 +71,10 @@ def agent_episodes(path):
     return episodes
 
 
-def went_for(poses_and_open):
-    """The xy the gripper went for: its first closing pose, or else its last pose."""
+def went_for(poses_and_open, values=2):
+    """Where the gripper went (xy, or xyz with values=3): its first closing pose, or else its last."""
     closing = [p for p, is_open in poses_and_open if not is_open]
-    return np.asarray((closing or [poses_and_open[-1][0]])[0])[:2]
+    return np.asarray((closing or [poses_and_open[-1][0]])[0])[:values]
 
 
 def nearest(found, xy):
@@ -81,8 +86,27 @@ def nearest(found, xy):
 KINDS = ["success", "distractor", "target", "elsewhere"]
 
 
+def classify_by_poses(found, agent):
+    """classify() with the simulator's objects (task_objects of the episode's first observation)."""
+    last = agent["obs"][-1]
+    failure = scalar(last, "failure", "")
+    if not agent["actions"]:
+        return ("success" if int(scalar(last, "success", 0)) else "elsewhere"), float("inf"), failure
+    point = went_for([(a.fields["pose"], int(scalar(a, "gripper_open", 1))) for a in agent["actions"]], 3)
+    distance = min((np.linalg.norm(box_centre(o)[:2] - point[:2]) for o in found), default=float("inf"))
+    if int(scalar(last, "success", 0)):
+        return "success", distance, failure
+    chosen = object_at(found, point, MARGIN_M)
+    if chosen is None:
+        return "elsewhere", distance, failure
+    return chosen.role, np.linalg.norm(box_centre(chosen)[:2] - point[:2]), failure
+
+
 def classify(expert, agent):
     """(kind, distance from where the agent went to the nearest object, failure reason)."""
+    with_poses = task_objects(agent["obs"][0]) if agent["obs"] else None
+    if with_poses is not None:
+        return classify_by_poses(with_poses, agent)
     found = objects(expert[0])
     last = agent["obs"][-1]
     failure = scalar(last, "failure", "")

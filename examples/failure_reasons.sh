@@ -13,7 +13,7 @@ scenes=(--task "$task" --variation "${VARIATION:-0}" --episodes "$episodes" --se
         --image-size "$image")
 demo-record "${scenes[@]}" --compress --output "$tmp/experts.rec" 2>/dev/null
 mkfifo "$tmp/loop"
-sim-step "${scenes[@]}" < "$tmp/loop" | qte-select --checkpoint "$checkpoint" --k "$k" "$@" --threads 1 \
+sim-step "${scenes[@]}" --objects < "$tmp/loop" | qte-select --checkpoint "$checkpoint" --k "$k" "$@" --threads 1 \
   | plan-path | tee "$tmp/loop" > "$tmp/agent.rec"
 /usr/bin/python3 "$here/failure_reasons.py" --label "$label" --seed "$seed" ${FAILURE_EPISODES:+--episodes} \
   "$tmp/experts.rec" "$tmp/agent.rec"

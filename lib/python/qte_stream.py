@@ -36,6 +36,11 @@ RECORD_TYPE = re.compile(rb"[a-z0-9_]{1,16}")
 FIELD_NAME = re.compile(rb"[A-Za-z0-9_.-]{1,255}")
 
 Record = collections.namedtuple("Record", "type fields offset index")
+# A task object of an observation written with `sim-step --objects` (or `demo-record
+# --objects`): its id (the row), name, role ("target", "distractor" or "other"), pose (x, y, z,
+# qx, qy, qz, qw, world frame) and bounding box in its own frame (lower and upper corner).
+SceneObject = collections.namedtuple("SceneObject", "id name role pose box_min box_max")
+ROLES = {0: "other", 1: "target", 2: "distractor"}
 
 
 class StreamError(Exception):
@@ -189,6 +194,21 @@ def _unzstd(data, raw_bytes, max_field_bytes, bad):
     if len(out) != raw_bytes:
         raise bad(f"zstd data does not decompress to {raw_bytes} bytes")
     return out
+
+
+def scene_objects(record):
+    """The task objects an observation carries (objects.*), as SceneObjects in id order; None
+    when it carries none (a stream written without --objects)."""
+    f = record.fields
+    if "objects.pose" not in f:
+        return None
+    names = f["objects.names"].split(",") if f["objects.names"] else []
+    pose, box, role = (np.asarray(f[k]) for k in ("objects.pose", "objects.box", "objects.role"))
+    if not (len(names) == len(role) == len(pose) == len(box)):
+        raise StreamError(f"record {record.index} at byte {record.offset}: objects.names, objects.role, "
+                          f"objects.pose and objects.box disagree on the number of objects")
+    return [SceneObject(i, names[i], ROLES.get(int(role[i]), "other"), pose[i], box[i, :3], box[i, 3:])
+            for i in range(len(names))]
 
 
 def main(paths):

@@ -27,6 +27,7 @@ stream::Record action_record(const Choice& choice, bool ignore_collisions, int k
     const Eigen::Vector3d centre = c.bounds[d].centre_of(c.indices[d]);
     a.set<double>(prefix + ".centre", {3}, centre.data());
     a.set_scalar<float>(prefix + ".q_value", c.q_values[d]);
+    if (d < c.argmax_indices.size()) a.set<int32_t>(prefix + ".argmax_index", {3}, c.argmax_indices[d].data());
   }
   a.set<int32_t>("rotation_bins", {3}, c.rotation_bins.data());
   a.set_scalar<float>("value", c.value);

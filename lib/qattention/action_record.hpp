@@ -11,7 +11,8 @@ namespace qte::qattention {
 
 // pose (x, y, z, qx, qy, qz, qw: the last depth's voxel centre turned by the rotation bins),
 // gripper_open, ignore_collisions; per depth the voxel's index, its grid's bounds, its centre
-// and its Q-value; rotation_bins, value, k, explored, checkpoint_step and the episode's step.
+// and its Q-value (and at non-leaf depths the grid's best-ranked voxel); rotation_bins, value,
+// k, explored, checkpoint_step and the episode's step.
 stream::Record action_record(const Choice& choice, bool ignore_collisions, int k, bool explored,
                              int64_t checkpoint_step, int32_t step);
 

@@ -33,6 +33,7 @@ Explored explore(const Choice& chosen, const Exploration& exploration, std::mt19
         c.indices[j + d + 1] = deeper.indices[j];
         c.bounds[j + d + 1] = deeper.bounds[j];
         c.q_values[j + d + 1] = deeper.q_values[j];
+        if (j + d + 1 < static_cast<int>(c.argmax_indices.size())) c.argmax_indices[j + d + 1] = deeper.argmax_indices[j];
         replaced[j + d + 1] = false;
       }
       c.rotation_bins = deeper.rotation_bins;

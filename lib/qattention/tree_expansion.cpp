@@ -216,6 +216,9 @@ std::vector<Choice> best_paths(Trees& trees, const Backup& backup, int voxels_pe
       const int voxel = d + 1 < depths ? trees.levels[d + 1][backup.best_child[d][node]].parent_voxel
                                        : argmax(trees.ranked[d].translation.data() + at, cells);
       choice.indices.push_back(voxels::index_from_flat(voxel, voxels_per_side));
+      if (d + 1 < depths)
+        choice.argmax_indices.push_back(
+            voxels::index_from_flat(argmax(trees.ranked[d].translation.data() + at, cells), voxels_per_side));
       choice.bounds.push_back(trees.levels[d][node].bounds);
       choice.q_values.push_back(outputs[d].translation[at + voxel]);
       if (d + 1 < depths) node = backup.best_child[d][node];

@@ -46,6 +46,10 @@ std::vector<int> branches(const float* q, int count, const Branching& branching)
 
 struct Choice {
   std::vector<Eigen::Vector3i> indices;       // per depth
+  // Per non-leaf depth, the best-ranked voxel of the grid the path passes through there (at
+  // depth 0, the argmax of depth 0's Q): where K = 1 would go from that grid. It differs from
+  // `indices` where a finer depth overruled the coarse choice.
+  std::vector<Eigen::Vector3i> argmax_indices;
   std::vector<voxels::GridBounds> bounds;     // per depth
   std::vector<float> q_values;                // the chosen voxel's Q, per depth (valuing networks)
   float value = 0;                            // the tree's value of the choice

@@ -112,7 +112,28 @@ stream::Record Simulator::observe(const std::string& failure) {
   obs.set_string("description", task_->description(variation_));
   obs.set_scalar<uint8_t>("ignore_collisions", ignore_collisions_);
   if (!failure.empty()) obs.set_string("failure", failure);
+  if (options_.object_poses) set_object_fields(obs, *world_);
   return obs;
+}
+
+void set_object_fields(stream::Record& obs, const world::World& world) {
+  const int n = world.object_count();
+  std::string names;
+  std::vector<uint8_t> roles;
+  std::vector<double> poses, boxes;
+  for (int id = 0; id < n; ++id) {
+    const world::ObjectSpec& spec = world.object_spec(id);
+    names += (id ? "," : "") + spec.name;
+    roles.push_back(static_cast<uint8_t>(spec.role));
+    const auto pose = robot::pose_values(world.object_pose(id));
+    poses.insert(poses.end(), pose.begin(), pose.end());
+    const Eigen::AlignedBox3d box = world.object_box(id);
+    for (const Eigen::Vector3d& corner : {box.min(), box.max()}) boxes.insert(boxes.end(), corner.data(), corner.data() + 3);
+  }
+  obs.set_string("objects.names", names);
+  obs.set<uint8_t>("objects.role", {n}, roles);
+  obs.set<double>("objects.pose", {n, robot::kPoseValues}, poses);
+  obs.set<double>("objects.box", {n, 6}, boxes);
 }
 
 void Simulator::handle(const stream::Record& record, const stream::Emit& emit) {

@@ -9,12 +9,15 @@ std::vector<cli::OptionSpec> camera_options() {
       {"cameras", "LIST", "comma-separated cameras: front, wrist, overhead", "front"},
       {"image-size", "WxH", "camera resolution, e.g. 128x128 or 256x256", "128x128"},
       {"compress", "", "zstd-compress images and point clouds (for files on disk)", ""},
+      {"objects", "", "also write every task object's name, role (target, distractor, other), pose and bounding box "
+                      "in observations (objects.*: for analyses of where an agent went; agents never read them)", ""},
   };
 }
 
 SimulatorOptions parse_camera_options(const cli::Arguments& args) {
   SimulatorOptions options = options_from_camera_arguments(args.text("cameras"), args.text("image-size"));
   options.compress_images = args.flag("compress");
+  options.object_poses = args.flag("objects");
   return options;
 }
 

@@ -9,7 +9,7 @@
 
 namespace qte::sim_step {
 
-// --cameras, --image-size, --compress.
+// --cameras, --image-size, --compress, --objects: what an observation holds.
 std::vector<cli::OptionSpec> camera_options();
 SimulatorOptions parse_camera_options(const cli::Arguments& args);
 

@@ -28,6 +28,7 @@ class LiftNumberedBlock : public Task {
                                    M_PI / 2 + yaw(rng), paper);
       const cv::Mat texture = render::text_texture(std::to_string(digit), 64, paper, ink);
       for (int face = 0; face < 5; ++face) spec.appearance.box_face_textures[face] = texture;
+      spec.role = digit == variation + 1 ? world::ObjectSpec::Role::target : world::ObjectSpec::Role::distractor;
       world.add_object(spec);
     }
     target_ = "block" + std::to_string(variation + 1);

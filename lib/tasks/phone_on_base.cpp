@@ -35,6 +35,7 @@ class PhoneOnBase : public Task {
     world.add_object(base);
     world::ObjectSpec phone = box("phone", kPhone, -side * uniform(rng, 0.08, 0.18), {0.08f, 0.08f, 0.12f});
     phone.mass_kg = 0.15;
+    phone.role = world::ObjectSpec::Role::target;
     world.add_object(phone);
   }
 

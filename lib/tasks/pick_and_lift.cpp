@@ -22,10 +22,15 @@ class PickAndLift : public Task {
                                             {kRegionMaxX, kRegionMaxY, 0}, 0.15);
     const auto distractors = pick_distinct(rng, 2, variation_count(), variation);
     std::uniform_real_distribution<double> yaw(-M_PI / 4, M_PI / 4);
-    world.add_object(block(world, "target", positions[0], yaw(rng), colours()[variation].rgb));
-    for (int i = 0; i < 2; ++i)
-      world.add_object(block(world, "distractor" + std::to_string(i + 1), positions[i + 1], yaw(rng),
-                             colours()[distractors[i]].rgb));
+    world::ObjectSpec target = block(world, "target", positions[0], yaw(rng), colours()[variation].rgb);
+    target.role = world::ObjectSpec::Role::target;
+    world.add_object(target);
+    for (int i = 0; i < 2; ++i) {
+      world::ObjectSpec distractor = block(world, "distractor" + std::to_string(i + 1), positions[i + 1], yaw(rng),
+                                           colours()[distractors[i]].rgb);
+      distractor.role = world::ObjectSpec::Role::distractor;
+      world.add_object(distractor);
+    }
     world.add_object(success_zone(world, positions[3], kZoneRadius));
   }
 

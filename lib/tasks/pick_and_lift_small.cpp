@@ -58,6 +58,7 @@ class PickAndLiftSmall : public Task {
       spec.pose.translation().z() += world::kHullMargin;  // resting on its margin
       spec.mass_kg = 0.03;
       spec.graspable = true;
+      spec.role = i == variation ? world::ObjectSpec::Role::target : world::ObjectSpec::Role::distractor;
       world.add_object(spec);
     }
     world.add_object(success_zone(world, zone_xy, kZoneRadius));

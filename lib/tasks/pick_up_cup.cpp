@@ -31,6 +31,7 @@ class PickUpCup : public Task {
                                     colours()[i == 0 ? variation : other].rgb);
       cup.mass_kg = 0.1;
       cup.graspable = true;
+      cup.role = i == 0 ? world::ObjectSpec::Role::target : world::ObjectSpec::Role::distractor;
       cup.grasp_region = Eigen::AlignedBox3d(Eigen::Vector3d(-kRadius, -kRadius, 0), Eigen::Vector3d(kRadius, kRadius, kHeight));
       world.add_object(cup);
       if (i == 0) start_ = pose.translation();

@@ -77,10 +77,12 @@ class PutRubbishInBin : public Task {
     world::ObjectSpec rubbish = solid("rubbish", {crumpled()}, resting(places[0], -0.015), {0.9f, 0.9f, 0.84f});
     rubbish.mass_kg = 0.02;
     rubbish.graspable = true;
+    rubbish.role = world::ObjectSpec::Role::target;
     world.add_object(rubbish);
     for (int i = 1; i <= 2; ++i) {
       world::ObjectSpec t = solid("tomato" + std::to_string(i), {tomato()}, resting(places[i], -0.022), {0.85f, 0.1f, 0.05f});
       t.mass_kg = 0.1;
+      t.role = world::ObjectSpec::Role::distractor;  // graspable-looking, not to be binned
       world.add_object(t);
     }
   }

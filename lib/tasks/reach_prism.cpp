@@ -28,7 +28,9 @@ class ReachPrism : public Task {
     const Eigen::Vector3f yellow(0.95f, 0.8f, 0.1f);
     auto prism = [&](const std::string& name, int sides, double radius, const Eigen::Vector3d& xy) {
       // Fixed where placed: reaching does not move it.
-      world.add_object(standing_prism(world, name, {regular_polygon(sides, radius)}, kHeight, xy, yaw(rng), yellow));
+      world::ObjectSpec spec = standing_prism(world, name, {regular_polygon(sides, radius)}, kHeight, xy, yaw(rng), yellow);
+      spec.role = name == "prism" ? world::ObjectSpec::Role::target : world::ObjectSpec::Role::distractor;
+      world.add_object(spec);
     };
     prism("prism", 5, 0.021, positions[0]);
     prism("triangular_prism", 3, 0.025, positions[1]);

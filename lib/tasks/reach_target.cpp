@@ -30,6 +30,7 @@ class ReachTarget : public Task {
     for (int i = 0; i < 3; ++i) {
       world::ObjectSpec sphere;
       sphere.name = i == 0 ? "target" : "distractor" + std::to_string(i);
+      sphere.role = i == 0 ? world::ObjectSpec::Role::target : world::ObjectSpec::Role::distractor;
       sphere.shape = world::ObjectSpec::Shape::sphere;
       sphere.size = Eigen::Vector3d(kRadius, 0, 0);
       sphere.pose.translation() = positions[i];

@@ -72,6 +72,8 @@ class SetupCheckers : public Task {
                                                world::kHullMargin + kCheckerHeight / 2);
       checker.mass_kg = 0.01;
       checker.graspable = true;
+      // The checkers to move; those already on their squares look just like them.
+      checker.role = stacked == off_board_.end() ? world::ObjectSpec::Role::distractor : world::ObjectSpec::Role::target;
       checker.appearance.colour = homes_[i].first[0] == 'r' ? Eigen::Vector3f(0.8f, 0.1f, 0.1f) : Eigen::Vector3f(0.12f, 0.12f, 0.12f);
       world.add_object(checker);
     }

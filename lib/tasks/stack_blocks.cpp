@@ -35,7 +35,9 @@ class StackBlocks : public Task {
     for (int i = 0; i < 2 * kPerColour; ++i) {
       const bool target = i < kPerColour;
       const std::string name = (target ? "target" : "distractor") + std::to_string(i % kPerColour + 1);
-      world.add_object(block(world, name, positions[i], yaw(rng), colours()[target ? variation / 3 : other].rgb));
+      world::ObjectSpec spec = block(world, name, positions[i], yaw(rng), colours()[target ? variation / 3 : other].rgb);
+      spec.role = target ? world::ObjectSpec::Role::target : world::ObjectSpec::Role::distractor;
+      world.add_object(spec);
     }
     world::ObjectSpec plane;
     plane.name = "target_plane";

@@ -53,6 +53,7 @@ class StackWine : public Task {
     world::ObjectSpec spec = solid("wine_bottle", bottle(), pose, {0.1f, 0.35f, 0.15f});
     spec.mass_kg = 0.3;
     spec.graspable = true;
+    spec.role = world::ObjectSpec::Role::target;
     spec.grasp_region = Eigen::AlignedBox3d(Eigen::Vector3d(-kBodyHalfLength, -kBodyRadius, -kBodyRadius),
                                             Eigen::Vector3d(kBodyHalfLength, kBodyRadius, kBodyRadius));
     world.add_object(spec);

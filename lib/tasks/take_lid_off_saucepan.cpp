@@ -41,6 +41,7 @@ class TakeLidOffSaucepan : public Task {
                                    lid, {0.75f, 0.75f, 0.8f});
     spec.mass_kg = 0.2;
     spec.graspable = true;
+    spec.role = world::ObjectSpec::Role::target;
     spec.grasp_region = Eigen::AlignedBox3d(Eigen::Vector3d(-kKnobRadius, -kKnobRadius, kLidThickness),
                                             Eigen::Vector3d(kKnobRadius, kKnobRadius, kLidThickness + kKnobHeight));
     world.add_object(spec);

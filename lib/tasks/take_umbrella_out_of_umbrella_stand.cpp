@@ -46,6 +46,7 @@ class TakeUmbrellaOutOfUmbrellaStand : public Task {
     world::ObjectSpec spec = solid("umbrella", umbrella(), pose, {0.55f, 0.1f, 0.15f});
     spec.mass_kg = 0.3;
     spec.graspable = true;
+    spec.role = world::ObjectSpec::Role::target;
     spec.grasp_region = Eigen::AlignedBox3d(Eigen::Vector3d(-kHandleRadius, -kHandleRadius, kHandleBottom),
                                             Eigen::Vector3d(kHandleRadius, kHandleRadius, kHandleTop));
     world.add_object(spec);

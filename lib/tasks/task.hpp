@@ -28,7 +28,10 @@ class Task {
   virtual int variation_count() const = 0;
   // In words, for people and logs, e.g. "lift the block numbered 2".
   virtual std::string description(int variation) const = 0;
-  // Adds the task's objects to an empty world, randomised by `rng`.
+  // Adds the task's objects to an empty world, randomised by `rng`, each with its role
+  // (ObjectSpec::Role): the objects the variation asks for are targets, their lookalikes
+  // and rivals distractors (the other blocks, shapes, cups, tomatoes, the checkers already
+  // home), the rest (zones, bins, boards, racks) other.
   virtual void build(world::World& world, int variation, std::mt19937_64& rng) = 0;
   virtual bool success(const world::World& world) const = 0;
   virtual std::vector<Waypoint> expert_waypoints(const world::World& world) const = 0;

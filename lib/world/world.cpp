@@ -211,6 +211,28 @@ Eigen::Isometry3d World::object_pose(int id) const {
   return from_bullet(impl_->objects.at(id).body->getWorldTransform());
 }
 
+Eigen::AlignedBox3d World::object_box(int id) const {
+  const ObjectSpec& spec = object_spec(id);
+  const Eigen::Vector3d& s = spec.size;
+  Eigen::AlignedBox3d box;
+  switch (spec.shape) {
+    case ObjectSpec::Shape::box:
+      return {-s / 2, s / 2};
+    case ObjectSpec::Shape::cylinder:  // about z: (radius, height)
+      return {Eigen::Vector3d(-s.x(), -s.x(), -s.y() / 2), Eigen::Vector3d(s.x(), s.x(), s.y() / 2)};
+    case ObjectSpec::Shape::sphere:
+      return {Eigen::Vector3d::Constant(-s.x()), Eigen::Vector3d::Constant(s.x())};
+    case ObjectSpec::Shape::convex_hull:
+      for (const auto& p : spec.hull_points) box.extend(p);
+      return box;
+    case ObjectSpec::Shape::compound:
+      for (const auto& piece : spec.pieces)
+        for (const auto& p : piece) box.extend(p);
+      return box;
+  }
+  return box;
+}
+
 Eigen::Isometry3d World::link_pose(int link) const {
   return robot_base_pose() * robot_.link_poses(q_, opening_m_)[link];
 }

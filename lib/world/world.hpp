@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -25,7 +26,12 @@ constexpr double kHullMargin = 0.001;
 
 struct ObjectSpec {
   enum class Shape { box, cylinder, sphere, convex_hull, compound };
+  // What the task makes of the object, for analyses of where an agent went (the codes the
+  // observations' objects.role carries): an object the task is about, one that looks like
+  // such an object or competes with it (a lookalike), or anything else (zones, bins, boards).
+  enum class Role : uint8_t { other = 0, target = 1, distractor = 2 };
   std::string name;
+  Role role = Role::other;
   Shape shape = Shape::box;
   Eigen::Vector3d size = Eigen::Vector3d::Constant(0.05);  // box: extents; cylinder: (radius,
                                                            // height, -); sphere: (radius, -, -)
@@ -60,6 +66,8 @@ class World {
   const ObjectSpec& object_spec(int id) const;
   int object_id(const std::string& name) const;  // throws Error when absent
   Eigen::Isometry3d object_pose(int id) const;
+  // The object's bounding box in its own frame, from its shape (no collision margin).
+  Eigen::AlignedBox3d object_box(int id) const;
 
   // --- the robot ------------------------------------------------------------------------
   // Places the arm and fingers at once (no physics in between): resets and teleports.

@@ -266,8 +266,23 @@ for what, data, where in [("truncated payload", plain[:-5], f"record {len(record
     except Exception as e:  # noqa: BLE001 - any other exception is the failure tested for
         failures.append(f"{what}: {type(e).__name__} instead of StreamError: {e}")
 
+# --- 5. the simulator's objects: scene_objects, None for streams without them -----------------
+with_objects = tool("sim-step", "--task", "pick_and_lift", "--seed", "2", "--image-size", "16x16", "--objects",
+                    stdin=b"")
+found = read_stream.scene_objects(next(read_stream.read_records(io.BytesIO(with_objects)))) or []
+if [(o.id, o.name, o.role) for o in found] != [(0, "target", "target"), (1, "distractor1", "distractor"),
+                                               (2, "distractor2", "distractor"), (3, "success_zone", "other")]:
+    failures.append(f"scene_objects: {[(o.id, o.name, o.role) for o in found]}")
+elif not (np.allclose(np.concatenate([found[0].box_min, found[0].box_max]), [-0.025] * 3 + [0.025] * 3)
+          and found[0].pose.shape == (7,) and abs(found[0].pose[2] - 0.777) < 0.002):  # a 5 cm block on the table
+    failures.append(f"scene_objects: the block at {found[0].pose}, box {found[0].box_min} {found[0].box_max}")
+old_obs = next(read_stream.read_records(os.path.join(SOURCE, "tests", "data", "pick_and_lift_obs.rec")))
+if read_stream.scene_objects(old_obs) is not None:
+    failures.append("scene_objects of a stream without objects is not None")
+
 print("\n".join(failures) or f"{len(records)} records read back bit for bit by the installed qte_stream, "
-      "stream-dump --json and stream-dump --npy (stacked and per record); damage raises StreamError")
+      "stream-dump --json and stream-dump --npy (stacked and per record); damage raises StreamError; "
+      "scene_objects decodes the simulator's objects")
 if failures:
     sys.exit(f"FAIL ({len(failures)} mismatches; files kept in {tmp})")
 shutil.rmtree(tmp)

@@ -48,6 +48,7 @@ records = list(read_records(path))
 fields = ["pose", "gripper_open", "ignore_collisions"]
 for d in range(2):
     fields += [f"depth{d}.index", f"depth{d}.bounds", f"depth{d}.centre", f"depth{d}.q_value"]
+    fields += ["depth0.argmax_index"] if d == 0 else []  # non-leaf depths: the grid's own best voxel
 fields += ["rotation_bins", "value", "k", "branches", "explored", "checkpoint_step", "step"]
 def bad(i, what):
     sys.exit(f"{path}: record {i}: {what}")
@@ -99,6 +100,12 @@ for i, r in enumerate(records):
         if not np.allclose(centre, bounds[:3] + (index + 0.5) * bounds[3] / 16, atol=1e-12):
             bad(i, f"depth {d} centre {centre} is not voxel {index}'s of {bounds}")
         q.append(float(a[f"depth{d}.q_value"]))
+    # Depth 0's argmax: a voxel of its grid; the one taken when nothing can overrule it.
+    argmax = a["depth0.argmax_index"]
+    if argmax.dtype != np.int32 or not ((argmax >= 0) & (argmax < 16)).all():
+        bad(i, f"depth 0 argmax {argmax}")
+    if k == 1 and int(a["explored"]) == 0 and not np.array_equal(argmax, a["depth0.index"]):
+        bad(i, f"K = 1 took {a['depth0.index']}, not depth 0's argmax {argmax}")
     # Depth 1 is centre +- 0.15 around depth 0's chosen voxel; the pose is depth 1's voxel.
     if not np.allclose(a["depth1.bounds"], list(a["depth0.centre"] - 0.15) + [0.3], atol=1e-12):
         bad(i, f"depth 1 bounds {a['depth1.bounds']} not around depth 0's voxel {a['depth0.centre']}")

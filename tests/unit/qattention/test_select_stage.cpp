@@ -68,6 +68,10 @@ TEST(SelectStage, EachLiveObservationIsFollowedByTheTreesAction) {
     const auto index = out[2].array<int32_t>("depth" + std::to_string(d) + ".index");
     EXPECT_EQ((Eigen::Vector3i(index[0], index[1], index[2])), direct.choice.indices[d]) << "depth " << d;
   }
+  // Depth 0's best-ranked voxel, where K = 1 would have gone; none at the leaf.
+  const auto argmax = out[2].array<int32_t>("depth0.argmax_index");
+  EXPECT_EQ((Eigen::Vector3i(argmax[0], argmax[1], argmax[2])), direct.choice.argmax_indices[0]);
+  EXPECT_FALSE(out[2].has("depth1.argmax_index"));
   EXPECT_EQ(out[2].scalar<int64_t>("checkpoint_step"), 12);
 
   stream::Record broken = observation(0, false);

@@ -81,6 +81,9 @@ TEST(TreeExpansion, KOneIsTheGreedyCoarseToFineChoice) {
   EXPECT_TRUE((c.bounds[1].min_corner + Eigen::Vector3d::Constant(0.15)).isApprox(a));
   EXPECT_EQ(c.rotation_bins[0], 10);
   EXPECT_FALSE(c.gripper_open);
+  // Nothing overruled: the recorded depth-0 argmax is the voxel taken; none for the leaf.
+  ASSERT_EQ(c.argmax_indices.size(), 1u);
+  EXPECT_EQ(c.argmax_indices[0], c.indices[0]);
 }
 
 TEST(TreeExpansion, AFinerDepthOverturnsTheCoarseChoiceInOneBatchedCall) {
@@ -96,6 +99,10 @@ TEST(TreeExpansion, AFinerDepthOverturnsTheCoarseChoiceInOneBatchedCall) {
   EXPECT_EQ(c.expanded_grids, 11);
   EXPECT_EQ(c.rotation_bins[0], 11);  // from the chosen branch's own outputs
   EXPECT_TRUE(c.gripper_open);
+  // What the action records of it: depth 0's argmax was A, which depth 1 overruled.
+  ASSERT_EQ(c.argmax_indices.size(), 1u);
+  EXPECT_EQ(c.argmax_indices[0], Eigen::Vector3i(3, 4, 5));
+  EXPECT_NE(c.argmax_indices[0], c.indices[0]);
 }
 
 TEST(TreeExpansion, RealNetworksGreedyEqualsManualArgmax) {

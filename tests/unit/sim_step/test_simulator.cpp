@@ -6,6 +6,7 @@
 #include <set>
 
 #include "common/random.hpp"
+#include "robot/pose_values.hpp"
 #include "trajectory_helpers.hpp"
 #include "stream/codec.hpp"
 #include "tasks/task.hpp"
@@ -82,6 +83,48 @@ TEST(Simulator, SameSeedSameBytesOtherSeedOtherScene) {
   };
   EXPECT_EQ(bytes(7), bytes(7));
   EXPECT_NE(bytes(7), bytes(8));
+}
+
+TEST(Simulator, ObjectsAreWrittenOnlyWhenAskedWithTheirRolesPosesAndBoxes) {
+  SimRun plain;
+  plain.send(reset_record("lift_numbered_block", 2, 3));
+  EXPECT_FALSE(plain.last().has("objects.pose"));  // observations as agents see them
+  EXPECT_FALSE(plain.last().has("objects.names"));
+
+  auto asked = [] {
+    SimulatorOptions options = small_options();
+    options.object_poses = true;
+    return options;
+  };
+  Simulator simulator(xarm(), asked());
+  std::vector<stream::Record> out;
+  simulator.handle(reset_record("lift_numbered_block", 2, 3), [&](const stream::Record& r) { out.push_back(r); });
+  const stream::Record& obs = out.back();
+  EXPECT_EQ(obs.string("objects.names"), "block1,block2,block3");
+  const auto role = obs.array<uint8_t>("objects.role");
+  ASSERT_EQ(role.shape, (stream::Shape{3}));
+  EXPECT_EQ(std::vector<uint8_t>(role.begin(), role.end()), (std::vector<uint8_t>{2, 2, 1}));  // block 3 the target
+  const auto pose = obs.array<double>("objects.pose");
+  const auto box = obs.array<double>("objects.box");
+  ASSERT_EQ(pose.shape, (stream::Shape{3, 7}));
+  ASSERT_EQ(box.shape, (stream::Shape{3, 6}));
+  const world::World& world = *simulator.world();
+  for (int id = 0; id < 3; ++id) {
+    const Eigen::Isometry3d p = world.object_pose(id);
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(pose[id * 7 + k], p.translation()[k]);
+    EXPECT_NEAR(std::abs(Eigen::Quaterniond(p.linear()).dot(robot::quaternion_of(&pose[id * 7]))), 1.0, 1e-6);
+    for (int k = 0; k < 3; ++k) {  // a 5 cm block about its centre
+      EXPECT_DOUBLE_EQ(box[id * 6 + k], -0.025);
+      EXPECT_DOUBLE_EQ(box[id * 6 + 3 + k], 0.025);
+    }
+  }
+  // The same scene with them: the same images, and the same bytes every time.
+  Simulator again(xarm(), asked());
+  std::vector<stream::Record> out_again;
+  again.handle(reset_record("lift_numbered_block", 2, 3), [&](const stream::Record& r) { out_again.push_back(r); });
+  EXPECT_EQ(stream::encode_record(out_again.back()), stream::encode_record(obs));
+  const auto rgb = obs.array<uint8_t>("front.rgb"), plain_rgb = plain.last().array<uint8_t>("front.rgb");
+  EXPECT_TRUE(std::equal(rgb.begin(), rgb.end(), plain_rgb.begin()));
 }
 
 TEST(Simulator, UnknownTaskIsAnErrorListingTheTasks) {

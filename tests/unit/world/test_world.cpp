@@ -39,3 +39,39 @@ TEST(World, EveryShapeFallsAndRestsOnTheTable) {
   EXPECT_THROW(world.object_id("nothing"), Error);
   EXPECT_THROW(world.add_object(box), Error);  // names are unique
 }
+
+TEST(World, ObjectBoxesAreTheShapesOwnBoundsInTheObjectFrame) {
+  world::World world(test_support::xarm());
+  world::ObjectSpec box, cylinder, sphere, hull, compound;
+  box.name = "box";
+  box.size = Eigen::Vector3d(0.04, 0.06, 0.02);
+  cylinder.name = "cylinder";
+  cylinder.shape = world::ObjectSpec::Shape::cylinder;
+  cylinder.size = Eigen::Vector3d(0.02, 0.06, 0);  // radius, height
+  sphere.name = "sphere";
+  sphere.shape = world::ObjectSpec::Shape::sphere;
+  sphere.size = Eigen::Vector3d(0.03, 0, 0);
+  hull.name = "hull";
+  hull.shape = world::ObjectSpec::Shape::convex_hull;
+  hull.hull_points = {{0, 0, 0}, {0.05, 0, 0}, {0, 0.02, 0}, {0, 0, 0.07}};
+  compound.name = "compound";  // off-centre pieces: a cup's origin is its bottom
+  compound.shape = world::ObjectSpec::Shape::compound;
+  compound.pieces = {{{-0.01, -0.01, 0}, {0.01, 0.01, 0}, {0, 0, 0.02}}, {{0.1, 0, 0.05}, {0.11, 0.01, 0.06}, {0.1, 0.01, 0.05}}};
+  double x = 0;
+  for (auto* spec : {&box, &cylinder, &sphere, &hull, &compound}) {
+    spec->mass_kg = 0;
+    x += 0.2;
+    spec->pose.translation() << x, 0, 1.5;  // apart, in the air: nothing touches
+    world.add_object(*spec);
+  }
+  auto expect_box = [&](const std::string& name, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+    const Eigen::AlignedBox3d b = world.object_box(world.object_id(name));
+    EXPECT_TRUE(b.min().isApprox(lo, 1e-12)) << name << ": " << b.min().transpose();
+    EXPECT_TRUE(b.max().isApprox(hi, 1e-12)) << name << ": " << b.max().transpose();
+  };
+  expect_box("box", {-0.02, -0.03, -0.01}, {0.02, 0.03, 0.01});
+  expect_box("cylinder", {-0.02, -0.02, -0.03}, {0.02, 0.02, 0.03});
+  expect_box("sphere", {-0.03, -0.03, -0.03}, {0.03, 0.03, 0.03});
+  expect_box("hull", {0, 0, 0}, {0.05, 0.02, 0.07});
+  expect_box("compound", {-0.01, -0.01, 0}, {0.11, 0.01, 0.06});
+}

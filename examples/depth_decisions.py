@@ -1,0 +1,125 @@
+#!/usr/bin/env python3
+"""Which depth decided: per depth, where the agent's chosen voxels lie — on the target, on a
+lookalike (a distractor) or elsewhere — and how often a finer depth overruled depth 0.
+
+    depth_decisions.py AGENT.rec [--label L] [--step N]
+
+AGENT.rec: the agent's episodes, observations written with the simulator's objects (sim-step
+--objects) and qte-select's actions after them (depth_decisions.sh records them). Each action
+is judged against the observation it was chosen for. A voxel lies on an object when its
+centre does by ambiguity.py's rule (object_at) with a margin of half the voxel's edge — inside
+the object's bounding box grown by half a voxel (the voxel touches the box) or up to 10 cm
+above it; a voxel on no target or distractor (on a zone, a bin, the table) is elsewhere.
+Actions that exploration changed are left out; --step N keeps only the actions chosen at the
+observations of step N (0: each episode's first decision).
+
+Printed as CSV, one row per line of the table:
+    depth<d>           the voxel chosen at depth d
+    depth0_argmax      depth 0's best voxel by its own Q (depth0.argmax_index): where K = 1
+                       would have gone
+    overruled          of the actions whose chosen depth-0 voxel is not depth 0's argmax (a
+                       finer depth overruled it; never with K = 1), the chosen voxel
+    overruled_argmax   of those actions, depth 0's argmax
+with the columns label, k (the actions' K), row, actions, target, lookalike, elsewhere and the
+three shares (empty when a row has no actions). Run with Debian's python3."""
+import argparse
+import csv
+import sys
+
+import numpy as np
+
+sys.path.insert(0, __file__.rsplit("/", 2)[0] + "/lib/python")  # or installed: make install
+from qte_stream import read_records  # noqa: E402
+from ambiguity import object_at, task_objects  # noqa: E402  (one rule for where an action went)
+
+PLACES = ["target", "lookalike", "elsewhere"]
+
+
+def scalar(record, name, default=None):
+    if name not in record.fields:
+        return default
+    return np.asarray(record.fields[name]).reshape(-1)[0]
+
+
+def voxel_edge(action, d):
+    """The edge of depth d's voxels: the grid's edge over its voxels per side, the voxels per side
+    from the chosen voxel's index and centre (centre = min + (index + 0.5) * edge / V)."""
+    bounds = np.asarray(action.fields[f"depth{d}.bounds"], np.float64)
+    index = np.asarray(action.fields[f"depth{d}.index"], np.float64)
+    centre = np.asarray(action.fields[f"depth{d}.centre"], np.float64)
+    per_side = np.rint(bounds[3] * (index[0] + 0.5) / (centre[0] - bounds[0]))
+    return bounds[3] / per_side
+
+
+def centre_of(action, d, index):
+    bounds = np.asarray(action.fields[f"depth{d}.bounds"], np.float64)
+    return bounds[:3] + (np.asarray(index, np.float64) + 0.5) * voxel_edge(action, d)
+
+
+def place(found, point, edge):
+    """Where a voxel centre lies: 'target', 'lookalike' or 'elsewhere'."""
+    on = object_at(found, point, edge / 2)
+    return {"target": "target", "distractor": "lookalike"}.get(on.role if on else None, "elsewhere")
+
+
+def decisions(records, step=None):
+    """Per action the agent took greedily: (k, {row: place}), each judged against the objects of
+    the observation before it."""
+    found, out = None, []
+    for r in records:
+        if r.type == "obs":
+            found = task_objects(r)
+            obs_step = int(scalar(r, "step", -1))
+            if found is None:
+                sys.exit(f"record {r.index}: an observation without objects.*: record the episodes with "
+                         "sim-step --objects (depth_decisions.sh does)")
+            continue
+        if r.type != "action" or found is None or int(scalar(r, "explored", 0)):
+            continue
+        if step is not None and obs_step != step:
+            continue
+        rows, d = {}, 0
+        while f"depth{d}.centre" in r.fields:
+            rows[f"depth{d}"] = place(found, r.fields[f"depth{d}.centre"], voxel_edge(r, d))
+            d += 1
+        if "depth0.argmax_index" in r.fields:
+            argmax = r.fields["depth0.argmax_index"]
+            rows["depth0_argmax"] = place(found, centre_of(r, 0, argmax), voxel_edge(r, 0))
+            if not np.array_equal(np.asarray(argmax), np.asarray(r.fields["depth0.index"])):
+                rows["overruled"] = rows["depth0"]
+                rows["overruled_argmax"] = rows["depth0_argmax"]
+        out.append((int(scalar(r, "k", 1)), rows))
+    return out
+
+
+def table(taken):
+    """{row: {place: count}} in the order of the module's text; the overruled rows always."""
+    depths = max((int(name[5:]) for _, rows in taken for name in rows if name[5:].isdigit()), default=-1) + 1
+    names = [f"depth{d}" for d in range(depths)] + ["depth0_argmax", "overruled", "overruled_argmax"]
+    counts = {name: dict.fromkeys(PLACES, 0) for name in names}
+    for _, rows in taken:
+        for name, where in rows.items():
+            counts[name][where] += 1
+    return counts
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("agent")
+    parser.add_argument("--label", default="")
+    parser.add_argument("--step", type=int, default=None, help="only the actions chosen at observations of step N")
+    args = parser.parse_args()
+    taken = decisions(read_records(args.agent), args.step)
+    if not taken:
+        sys.exit(f"{args.agent}: no greedy actions after observations with objects")
+    ks = sorted({k for k, _ in taken})
+    out = csv.writer(sys.stdout, lineterminator="\n")
+    out.writerow(["label", "k", "row", "actions"] + PLACES + [p + "_share" for p in PLACES])
+    for name, count in table(taken).items():
+        n = sum(count.values())
+        shares = [f"{count[p] / n:.3f}" if n else "" for p in PLACES]
+        out.writerow([args.label, "/".join(map(str, ks)), name, n] + [count[p] for p in PLACES] + shares)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Which depth decided, for a checkpoint's greedy agent on the held-out evaluation scenes
+# (depth_decisions.py): per depth, how often the chosen voxel lies on the target, on a lookalike
+# or elsewhere, and how often a finer depth overruled depth 0's argmax (tree expansion, K > 1).
+# Usage: depth_decisions.sh TASK CHECKPOINT K [IMAGE] [EPISODES] [LABEL] [QTE-SELECT OPTIONS...]
+#        (the built programs on PATH). The scenes are learn.sh's evaluation scenes: VARIATION
+#        (0) and EVAL_SEED (1000000) as there, as failure_reasons.sh replays them. DECISION_STEP=N:
+#        only the decisions at step N of each episode (0: the first). AGENT=FILE keeps the
+#        episodes' records there.
+set -euo pipefail
+task=$1 checkpoint=$2 k=$3 image=${4:-256x256} episodes=${5:-50} label=${6:-k$3}
+shift $(( $# < 6 ? $# : 6 ))
+here=$(cd "$(dirname "$0")" && pwd)
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+agent=${AGENT:-$tmp/agent.rec}
+mkfifo "$tmp/loop"
+sim-step --task "$task" --variation "${VARIATION:-0}" --episodes "$episodes" --seed "${EVAL_SEED:-1000000}" \
+    --scenes eval --image-size "$image" --objects < "$tmp/loop" \
+  | qte-select --checkpoint "$checkpoint" --k "$k" "$@" --threads 1 \
+  | plan-path | tee "$tmp/loop" > "$agent"
+/usr/bin/python3 "$here/depth_decisions.py" --label "$label" ${DECISION_STEP:+--step "$DECISION_STEP"} "$agent"

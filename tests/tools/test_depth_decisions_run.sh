@@ -1,0 +1,98 @@
+#!/usr/bin/env bash
+# examples/depth_decisions.sh and .py on the simulator's own objects: a real scene
+# (sim-step --objects) with actions placed on the target, on a lookalike and away from both
+# gives the known table; the acting loop on two reach_prism scenes gives a table whose rows
+# add up to the actions qte-select took, whose overruled row counts the actions whose depth-0
+# voxel is not depth 0's argmax, and with K = 1 overrules nothing; a stream without objects is
+# refused, naming the option.
+source "$(dirname "$0")/common.sh"
+py=/usr/bin/python3
+src=${QTE_SOURCE:?set QTE_SOURCE to the repository}
+export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-PASSIVE}
+export PYTHONPATH="$src/lib/python"
+
+# --- a known answer: lift_numbered_block variation 1, block 2 the target -----------------------
+stream-pack reset task=lift_numbered_block variation:i32=1 seed:i64=3 \
+  | sim-step --image-size 32x32 --objects > "$tmp/obs.rec" || fail "sim-step --objects"
+# An action whose voxels (depth 0 over the 1 m scene, depth 1 the 30 cm around it, 16 per side)
+# hold the point WHERE (target, lookalike or away), depth 0's argmax holding ARGMAX's point.
+action() {
+  $py - "$tmp/obs.rec" "$1" "$2" <<'EOF'
+import sys
+import numpy as np
+import qte_stream
+obs = next(r for r in qte_stream.read_records(sys.argv[1]) if r.type == "obs")
+objects = {o.name: o for o in qte_stream.scene_objects(obs)}
+assert [objects[n].role for n in ("block1", "block2", "block3")] == ["distractor", "target", "distractor"], objects
+points = {"target": objects["block2"].pose[:3], "lookalike": objects["block1"].pose[:3],
+          "away": (objects["block1"].pose[:3] + objects["block3"].pose[:3]) / 2 + [0, 0, 0.3]}
+fields, bounds = [], np.array([-0.3, -0.5, 0.6, 1.0])
+for d in range(2):
+    edge = bounds[3] / 16
+    index = np.floor((points[sys.argv[2]] - bounds[:3]) / edge).astype(int)
+    centre = bounds[:3] + (index + 0.5) * edge
+    text = lambda v: ",".join(repr(float(x)) for x in v)
+    fields += [f"depth{d}.index:i32=" + ",".join(map(str, index)), f"depth{d}.bounds:f64={text(bounds)}",
+               f"depth{d}.centre:f64={text(centre)}"]
+    if d == 0:
+        argmax = np.floor((points[sys.argv[3]] - bounds[:3]) / edge).astype(int)
+        fields.append("depth0.argmax_index:i32=" + ",".join(map(str, argmax)))
+    bounds = np.concatenate([centre - 0.15, [0.3]])
+print(" ".join(fields + ["k:i32=10", "explored:u8=0"]))
+EOF
+}
+{
+  cat "$tmp/obs.rec"; stream-pack action $(action target target) || exit 1
+  cat "$tmp/obs.rec"; stream-pack action $(action lookalike lookalike) || exit 1
+  cat "$tmp/obs.rec"; stream-pack action $(action away target) || exit 1  # overruled, to nowhere
+} > "$tmp/known.rec" || fail "building the known actions"
+$py "$src/examples/depth_decisions.py" --label known "$tmp/known.rec" > "$tmp/known.csv" || fail "depth_decisions.py exit $?"
+expected='label,k,row,actions,target,lookalike,elsewhere,target_share,lookalike_share,elsewhere_share
+known,10,depth0,3,1,1,1,0.333,0.333,0.333
+known,10,depth1,3,1,1,1,0.333,0.333,0.333
+known,10,depth0_argmax,3,2,1,0,0.667,0.333,0.000
+known,10,overruled,1,0,0,1,0.000,0.000,1.000
+known,10,overruled_argmax,1,1,0,0,1.000,0.000,0.000'
+[ "$(cat "$tmp/known.csv")" = "$expected" ] || fail "the known table: $(cat "$tmp/known.csv")"
+
+# --- the acting loop: fresh networks on two reach_prism scenes ---------------------------------
+keyframe "$src/tests/data/reach_target_demo.rec" > "$tmp/transitions.rec" 2>/dev/null || fail "keyframe"
+qattn-train --steps 0 --seed 1 --checkpoint-dir "$tmp/ckpt" "$tmp/transitions.rec" 2>/dev/null || fail "qattn-train"
+for k in 3 1; do
+  AGENT="$tmp/agent$k.rec" timeout 300 bash "$src/examples/depth_decisions.sh" reach_prism "$tmp/ckpt/latest.rec" $k 32x32 2 \
+    > "$tmp/k$k.csv" 2> "$tmp/k$k.err" || fail "depth_decisions.sh with K = $k: exit $?: $(cat "$tmp/k$k.err")"
+  $py - "$tmp/agent$k.rec" "$tmp/k$k.csv" $k <<'EOF' || fail "the table with K = $k does not add up"
+import csv, sys
+import numpy as np
+import qte_stream
+actions = [r for r in qte_stream.read_records(sys.argv[1]) if r.type == "action"]
+overruled = sum(not np.array_equal(a.fields["depth0.index"], a.fields["depth0.argmax_index"]) for a in actions)
+rows = {r["row"]: r for r in csv.DictReader(open(sys.argv[2]))}
+problems = []
+if list(rows) != ["depth0", "depth1", "depth0_argmax", "overruled", "overruled_argmax"]:
+    problems.append(f"rows {list(rows)}")
+for name, r in rows.items():
+    n = int(r["actions"])
+    want = overruled if name.startswith("overruled") else len(actions)
+    if n != want:
+        problems.append(f"{name}: {n} actions, the stream has {want}")
+    if int(r["target"]) + int(r["lookalike"]) + int(r["elsewhere"]) != n:
+        problems.append(f"{name}: the places do not add up to {n}")
+    if n and abs(sum(float(r[p + "_share"]) for p in ("target", "lookalike", "elsewhere")) - 1) > 0.002:
+        problems.append(f"{name}: the shares do not add up to 1")
+    if r["k"] != sys.argv[3]:
+        problems.append(f"{name}: k {r['k']}")
+if not actions:
+    problems.append("no actions")
+if sys.argv[3] == "1" and (overruled or [rows["depth0"][p] for p in ("target", "lookalike", "elsewhere")]
+                           != [rows["depth0_argmax"][p] for p in ("target", "lookalike", "elsewhere")]):
+    problems.append("K = 1 overruled depth 0")
+if problems:
+    sys.exit("; ".join(problems))
+EOF
+done
+
+# --- a stream without objects is refused, naming the option -----------------------------------
+err=$($py "$src/examples/depth_decisions.py" "$src/tests/data/pick_and_lift_obs.rec" 2>&1); rc=$?
+[ $rc != 0 ] && grep -q "sim-step --objects" <<<"$err" || fail "a stream without objects: exit $rc: $err"
+echo "depth decisions ok"
