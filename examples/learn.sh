@@ -146,6 +146,15 @@ kill_tree() {  # PID...: each process and its descendants, children first
 # trajectories go back to sim-step, so a pipeline waiting at its gate holds nothing in flight.
 actor_replay=$run/replay.rec
 [ "$ROLE" != actor ] || actor_replay=$run/actors/replay-$ACTOR_INDEX.rec
+# A run killed while an episode was being appended leaves a torn last record in the replay; the
+# run is the file's only writer, so on resume the torn record is cut off (its chunk runs again)
+# and the cut is logged, instead of every later append being refused.
+repair_replay() {  # FILE
+  local said
+  [ -s "$1" ] || return 0
+  said=$(stream-cat --append --repair --output "$1" /dev/null 2>&1) || { log "$said"; exit 1; }
+  [ -z "$said" ] || log "$task $LABEL seed $SEED: $said"
+}
 gate_dir() { echo "$run/actors/gate-$1"; }  # ACTOR
 chunk_done() { [ -f "$(gate_dir $(( $1 % ACTORS )))/$(printf '%04d' "$1").steps" ]; }  # CHUNK
 next_chunk() {  # ACTOR -> its first chunk not finished
@@ -223,6 +232,7 @@ if [ "$ROLE" = actor ]; then
   mkdir -p "$run/actors"
   until [ -f "$run/ckpt/latest.rec" ]; do nap 2; done
   rm -f "$(gate_dir "$ACTOR_INDEX")"/*.go "$(gate_dir "$ACTOR_INDEX")/stop"
+  repair_replay "$actor_replay"
   trap 'kill_tree "${actor_pids[@]}"' EXIT
   start_actor "$ACTOR_INDEX"
   chunk=$(next_chunk "$ACTOR_INDEX")
@@ -249,6 +259,7 @@ fi
 
 # 2. The learner, in the background for the whole run; with ROLE=learner it follows the
 # actors' replay files too (made empty here if no actor has started yet).
+repair_replay "$run/replay.rec"
 inputs=("$run/replay.rec")
 if [ "$ROLE" = learner ]; then
   mkdir -p "$run/actors"

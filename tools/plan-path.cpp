@@ -62,20 +62,19 @@ static void run(const cli::Arguments& args) {
   options.clearance_m = args.real("clearance", 0, 0.5);
   options.scene.resolution_m = args.real("resolution", 0.002, 0.1);
   options.seed = args.seed();
-  if (!(options.time_budget_s > 0) || !(options.velocity_scale > 0 && options.velocity_scale <= 1) ||
-      !(options.max_acceleration_rad_s2 > 0) || !(options.scene.resolution_m >= 0.002))
-    throw UsageError("--time-budget, --acceleration must be positive, --velocity-scale in (0, 1], --resolution >= 0.002");
   const robot::RobotModel robot = robot::RobotModel::xarm7();
   const Eigen::Isometry3d world_from_base = world::SceneLayout{}.robot_base_pose();
   planning::PlanPathFilter filter(robot, world_from_base, options);
   filter.observe_through(point_clouds::observation_filter(point_clouds::parse_cloud_filters(args)));
   stream::RecordReader reader(args.input());
   stream::RecordWriter writer(args.text("output"));
-  stream::run_stage(filter, reader, writer);
+  // The map before the stream is committed: a map that cannot be written leaves no --output.
+  stream::run_stage(filter, [&] { return reader.next(); }, [&](const stream::Record& r) { writer.write(r); });
   if (args.has("octomap")) {
     if (!filter.last_scene()) throw Error("--octomap: no action was planned, so there is no scene map");
     filter.last_scene()->write_binary(args.text("octomap"));
   }
+  writer.close();
 }
 
 int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }

@@ -1,10 +1,7 @@
 // plot-curves: learning curves from CSV tables (episode-stats rows, training metrics) to PNG,
 // mean over the rows at each x with a std or confidence band, one curve per group.
-#include <cmath>
-#include <cstdio>
-#include <tuple>
-
 #include <array>
+#include <tuple>
 
 #include "cli/command.hpp"
 #include "common/error.hpp"
@@ -79,40 +76,15 @@ static cli::Usage usage() {
   return u;
 }
 
-static std::pair<double, double> parse_range(const std::string& text) {
-  double lo = 0, hi = 0;
-  char rest = 0;
-  if (std::sscanf(text.c_str(), "%lf,%lf%c", &lo, &hi, &rest) != 2 || !std::isfinite(lo) || !std::isfinite(hi) ||
-      !(lo < hi))
-    throw UsageError("--y-range: expected LO,HI with LO < HI, got '" + text + "'");
-  return {lo, hi};
-}
-
-static std::pair<int, int> parse_size(const std::string& text) {
-  int w = 0, h = 0;
-  char rest = 0;
-  if (std::sscanf(text.c_str(), "%dx%d%c", &w, &h, &rest) != 2 || w < 200 || h < 150 || w > 10000 || h > 10000)
-    throw UsageError("--size: expected WxH between 200x150 and 10000x10000, got '" + text + "'");
-  return {w, h};
-}
-
-static int parse_columns(const std::string& text) {
-  int n = 0;
-  char rest = 0;
-  if (std::sscanf(text.c_str(), "%d%c", &n, &rest) != 1 || n < 1 || n > 100)
-    throw UsageError("--panel-columns: expected a number from 1 to 100, got '" + text + "'");
-  return n;
-}
-
 static void run(const cli::Arguments& args) {
   report::CurveColumns columns{args.text("x"), args.text("y"), args.text("group"), args.text("panel")};
   const std::string output = args.text("output");
   const report::Band band =
       std::array{report::Band::std_dev, report::Band::ci, report::Band::none}[args.choice("band", {"std", "ci", "none"})];
   report::CurvePlotOptions plot;
-  std::tie(plot.width_px, plot.height_px) = parse_size(args.text("size"));
+  std::tie(plot.width_px, plot.height_px) = args.size("size", 200, 150, 10000, 10000);
   plot.fixed_y = args.has("y-range");
-  if (plot.fixed_y) std::tie(plot.y_min, plot.y_max) = parse_range(args.text("y-range"));
+  if (plot.fixed_y) std::tie(plot.y_min, plot.y_max) = args.range("y-range");
   plot.title = args.text("title");
   plot.x_label = args.has("x-label") ? args.text("x-label") : columns.x;
   plot.y_label = args.has("y-label") ? args.text("y-label") : columns.y;
@@ -123,7 +95,7 @@ static void run(const cli::Arguments& args) {
   if (columns.panel.empty())
     report::save_curve_plot(output, curves.curves(), plot);
   else
-    report::save_panel_plot(output, curves.panels(), plot, parse_columns(args.text("panel-columns")));
+    report::save_panel_plot(output, curves.panels(), plot, static_cast<int>(args.integer("panel-columns", 1, 100)));
 }
 
 int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }

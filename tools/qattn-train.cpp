@@ -128,15 +128,15 @@ static void run(const cli::Arguments& args) {
                                                        : nets::default_base_channels(config.net.architecture);
   config.hierarchy = voxels::parse_hierarchy(args, 4, 128);  // the networks' smallest and largest grids
   config.batch = static_cast<int>(args.integer("batch", 1, 100000));
-  config.gamma = args.real("gamma");
-  config.reward_scale = args.real("reward-scale");
-  config.tau = args.real("tau");
-  config.learning_rate = args.real("lr");
-  config.weight_decay = args.real("weight-decay");
-  config.grad_clip_value = args.real("grad-clip-value");
-  config.grad_clip_norm = args.real("grad-clip-norm");
-  config.q_regularisation = args.real("q-reg");
-  config.huber_delta = args.real("huber-delta");
+  config.gamma = args.real("gamma", 0, 1);
+  config.reward_scale = args.real("reward-scale", 1e-9, 1e9);
+  config.tau = args.real("tau", 0, 1);
+  config.learning_rate = args.real("lr", 1e-12, 1e30);  // any positive rate (a test diverges on purpose)
+  config.weight_decay = args.real("weight-decay", 0, 1e3);
+  config.grad_clip_value = args.real("grad-clip-value", 0, 1e12);
+  config.grad_clip_norm = args.real("grad-clip-norm", 0, 1e12);
+  config.q_regularisation = args.real("q-reg", 0, 1e6);
+  config.huber_delta = args.real("huber-delta", 1e-9, 1e9);
   config.tree_branching = qattention::parse_branching(args, "tree-target", 0);
   config.tree_target_k = config.tree_branching.k;
   config.n_step = static_cast<int>(args.integer("n-step", 1, 10));
@@ -147,8 +147,8 @@ static void run(const cli::Arguments& args) {
   loop.steps = args.integer("steps", 0, 1000000000000);
   loop.start_after = args.integer("start-after", 0, 1000000000000);
   loop.pretrain = args.integer("pretrain", 0, 1000000000000);
-  loop.replay_ratio = args.real("replay-ratio");
-  loop.beta = args.real("beta");
+  loop.replay_ratio = args.real("replay-ratio", 0, 1e6);
+  loop.beta = args.real("beta", 0, 1);
   loop.follow = args.flag("follow");
   loop.stop_file = args.text("stop-file");
   loop.checkpoint_every = args.integer("checkpoint-every", 1, 1000000000000);
@@ -165,7 +165,7 @@ static void run(const cli::Arguments& args) {
   replay::ReplayOptions replay_options;
   replay_options.capacity = static_cast<std::size_t>(std::max<int64_t>(1, args.integer("capacity", 1, 1000000000)));
   replay_options.prioritised = !args.flag("uniform");
-  replay_options.alpha = args.real("alpha");
+  replay_options.alpha = args.real("alpha", 0, 10);
 
   nets::set_torch_threads(loop.threads);
   nets::seed_torch(loop.seed);

@@ -77,7 +77,7 @@ static cli::Usage usage() {
        "bytes for the same --threads; another count sums in another order, so Q values may differ in "
        "their last bit (measured: the same voxels in 19 of 19 actions, 3 values 1e-7 apart)",
        "2"},
-      {"png", "DIR", "save the Q-values of every depth's grid as DIR/<n>.depth<d>.png", ""},
+      {"png", "DIR", "save the Q-values of every depth's grid as DIR/<n>.depth<d>.png (all at the end of the input, or none)", ""},
   };
   u.options.push_back(cli::output_file());
   u.add_options(voxels::checkpoint_hierarchy_options());
@@ -101,24 +101,12 @@ static cli::Usage usage() {
 
 namespace {
 
-double probability(const cli::Arguments& args, const std::string& name) {
-  const double x = args.real(name);
-  if (!(x >= 0 && x <= 1)) throw UsageError("--" + name + " must be between 0 and 1");
-  return x;
-}
-
-double non_negative(const cli::Arguments& args, const std::string& name) {
-  const double x = args.real(name);
-  if (!(x >= 0 && std::isfinite(x))) throw UsageError("--" + name + " must be a non-negative number");
-  return x;
-}
-
 qattention::Exploration exploration_from(const cli::Arguments& args) {
   qattention::Exploration exploration;
-  exploration.epsilon = probability(args, "epsilon");
-  exploration.index_noise = non_negative(args, "index-noise");
-  exploration.rotation_noise = non_negative(args, "rotation-noise");
-  exploration.gripper_flip = probability(args, "gripper-flip");
+  exploration.epsilon = args.real("epsilon", 0, 1);
+  exploration.index_noise = args.real("index-noise", 0, 1e6);
+  exploration.rotation_noise = args.real("rotation-noise", 0, 1e6);
+  exploration.gripper_flip = args.real("gripper-flip", 0, 1);
   return exploration;
 }
 
@@ -131,7 +119,6 @@ static void run(const cli::Arguments& args) {
   options.exploration = exploration_from(args);
   options.ignore_collisions = args.flag("ignore-collisions");
   options.reload = args.flag("reload");
-  options.png_dir = args.text("png");
   options.seed = args.seed();
   options.prepare = point_clouds::observation_filter(point_clouds::parse_cloud_filters(args));
 
@@ -139,12 +126,15 @@ static void run(const cli::Arguments& args) {
   qattention::CheckpointNetworks networks(checkpoint);
   options.hierarchy = voxels::checkpoint_hierarchy(args, networks.hierarchy(), networks.config().net.voxels,
                                                    networks.config().depths, checkpoint);
-  if (!options.png_dir.empty()) make_output_directory(options.png_dir);
+  std::unique_ptr<OutputDirectory> pictures;  // all or none, when the input ends
+  if (args.has("png")) pictures = std::make_unique<OutputDirectory>(args.text("png"));
+  if (pictures) options.png_dir = pictures->staging();
 
   qattention::SelectStage stage(networks, options);
   stream::RecordReader reader(args.input());
   stream::RecordWriter writer(args.text("output"));
   stream::run_stage(stage, reader, writer);
+  if (pictures) pictures->commit();
 }
 
 int main(int argc, char** argv) {

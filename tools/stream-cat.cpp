@@ -78,8 +78,7 @@ static void run(const cli::Arguments& args) {
     conditions.push_back({where.substr(0, eq), where.substr(eq + 1)});
   }
   stream::ReadOptions read_options;
-  if (args.integer("max-record-bytes") <= 0) throw UsageError("--max-record-bytes must be positive");
-  read_options.max_record_bytes = static_cast<uint64_t>(args.integer("max-record-bytes"));
+  read_options.max_record_bytes = static_cast<uint64_t>(args.integer("max-record-bytes", 1, INT64_MAX));
   stream::WriteOptions write_options;
   if (args.flag("append")) write_options.mode = stream::WriteMode::append;
   write_options.repair = args.flag("repair");

@@ -1,5 +1,6 @@
 // stream-dump: print any record stream (text or JSON Lines), filter by type, export .npy.
 
+#include <filesystem>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -37,6 +38,8 @@ static cli::Usage usage() {
       "DIR/<index>.<camera>.pcd: the world-frame point cloud (the stored points, or points "
       "rebuilt from depth) with its colours, binary XYZRGB, organized as the image (NaN where a "
       "pixel has no return), for pcl_viewer and other PCL programs.",
+      "The exported files appear all or none: a dump stopped by damage leaves the directories "
+      "as they were.",
   };
   u.arguments = {cli::input_files()};
   u.options = {
@@ -76,15 +79,18 @@ static void run(const cli::Arguments& args) {
   const std::set<std::string> types(wanted.begin(), wanted.end());
   stream::InspectOptions inspect;
   inspect.max_values = args.flag("all-values") ? -1 : args.integer("values", -1, 1000000000);
-  const std::string npy_dir = args.text("npy"), pcd_dir = args.text("pcd");
-  for (const std::string& dir : {npy_dir, pcd_dir})
-    if (!dir.empty()) make_output_directory(dir);
-  if (args.flag("per-record") && npy_dir.empty()) throw UsageError("--per-record goes with --npy DIR");
+  if (args.flag("per-record") && !args.has("npy")) throw UsageError("--per-record goes with --npy DIR");
+  // The exported files appear all or none (one staging directory when both options name one).
+  std::unique_ptr<OutputDirectory> npy_out, pcd_out;
+  if (args.has("npy")) npy_out = std::make_unique<OutputDirectory>(args.text("npy"));
+  std::error_code not_same;
+  if (args.has("pcd") && !(npy_out && std::filesystem::equivalent(args.text("npy"), args.text("pcd"), not_same)))
+    pcd_out = std::make_unique<OutputDirectory>(args.text("pcd"));
+  OutputDirectory* pcd = pcd_out ? pcd_out.get() : args.has("pcd") ? npy_out.get() : nullptr;
   std::unique_ptr<stream::NpyExport> npy;
-  if (!npy_dir.empty()) npy = std::make_unique<stream::NpyExport>(npy_dir, args.flag("per-record"));
+  if (npy_out) npy = std::make_unique<stream::NpyExport>(npy_out->staging(), args.flag("per-record"));
   stream::ReadOptions read_options;
-  if (args.integer("max-record-bytes") <= 0) throw UsageError("--max-record-bytes must be positive");
-  read_options.max_record_bytes = static_cast<uint64_t>(args.integer("max-record-bytes"));
+  read_options.max_record_bytes = static_cast<uint64_t>(args.integer("max-record-bytes", 1, INT64_MAX));
 
   std::map<std::string, std::pair<uint64_t, uint64_t>> totals;  // type -> (records, bytes)
   for (const std::string& file : files) {
@@ -99,9 +105,9 @@ static void run(const cli::Arguments& args) {
       total.second += bytes;
       char index[16];
       std::snprintf(index, sizeof index, "%06llu", static_cast<unsigned long long>(record->position.record_index));
-      if (!pcd_dir.empty() && (record->type() == "obs" || record->type() == "frame"))
+      if (pcd && (record->type() == "obs" || record->type() == "frame"))
         for (const auto& camera : voxels::camera_clouds(*record))
-          point_clouds::write_pcd(pcd_dir + "/" + index + "." + camera.camera + ".pcd", camera);
+          point_clouds::write_pcd(pcd->path(std::string(index) + "." + camera.camera + ".pcd"), camera);
       if (npy) npy->add(*record);
       if (args.flag("summary")) continue;
       if (args.flag("json")) stream::print_record_json(std::cout, *record, bytes, inspect);
@@ -110,6 +116,8 @@ static void run(const cli::Arguments& args) {
     }
   }
   if (npy) npy->finish();
+  for (OutputDirectory* out : {npy_out.get(), pcd_out.get()})
+    if (out) out->commit();
   if (args.flag("summary")) {
     for (const auto& [type, total] : totals)
       std::cout << type << "\t" << total.first << " records\t" << total.second << " bytes\n";

@@ -25,7 +25,7 @@ static cli::Usage usage() {
       "named *.depth as colour-mapped depth (near warm, far cool, no return black). With "
       "--depth-mm depth is also saved as a 16-bit PNG in millimetres (0 = no return), the form "
       "depth cameras save and obs-pack reads. Files are named <record index>.<field>.png (index "
-      "zero-padded to 6 digits) and written atomically.",
+      "zero-padded to 6 digits), and they appear all or none: a run that fails leaves DIR as it was.",
       "With --video FILE.mp4 (or FILE.gif, an animated GIF for web pages) the camera's images "
       "become the frames of one video instead, at --fps. With --attention DIR, the pictures "
       "qte-select --png DIR saved for its actions (DIR/<n>.depth<d>.png, n from 0) are shown "
@@ -61,11 +61,11 @@ static cli::Usage usage() {
 
 namespace {
 
-void save_pngs(const stream::Record& record, const std::string& dir, bool depth, bool depth_mm) {
+void save_pngs(const stream::Record& record, const OutputDirectory& dir, bool depth, bool depth_mm) {
   char index[16];
   std::snprintf(index, sizeof index, "%06llu", static_cast<unsigned long long>(record.position.record_index));
   for (const auto& field : record.fields()) {
-    const std::string path = dir + "/" + index + "." + field.name();
+    const std::string path = dir.path(std::string(index) + "." + field.name());
     if (stream::ends_with(field.name(), ".rgb")) render::save_rgb_png(path + ".png", video::image_field(record, field, false));
     if (!stream::ends_with(field.name(), ".depth") || !(depth || depth_mm)) continue;
     const cv::Mat metres = video::image_field(record, field, true);
@@ -86,13 +86,14 @@ static void run(const cli::Arguments& args) {
   if (args.has("attention") && !std::filesystem::is_directory(args.text("attention")))
     throw UsageError("--attention " + args.text("attention") + ": no such directory (qte-select --png DIR writes the pictures)");
   std::unique_ptr<video::EpisodeVideo> video;
+  std::unique_ptr<OutputDirectory> pictures;
   if (args.has("video")) {
     if (type != "obs") throw UsageError("--video shows observations: --type obs");
     video = std::make_unique<video::EpisodeVideo>(args.text("video"), args.real("fps", 0.01, 1000),
                                                   args.text("camera"), args.text("attention"),
                                                   static_cast<int>(args.integer("height", 16, 4096)));
   } else {
-    make_output_directory(dir);
+    pictures = std::make_unique<OutputDirectory>(dir);
   }
   if (args.has("attention") && !video) throw UsageError("--attention goes with --video");
   int64_t seen = 0;
@@ -102,10 +103,11 @@ static void run(const cli::Arguments& args) {
       if (record->type() != type) continue;
       const bool shown = seen++ % every == 0;
       if (video) video->add(*record, shown);
-      else if (shown) save_pngs(*record, dir, args.flag("depth"), args.flag("depth-mm"));
+      else if (shown) save_pngs(*record, *pictures, args.flag("depth"), args.flag("depth-mm"));
     }
   }
   if (video) video->close();
+  if (pictures) pictures->commit();
 }
 
 int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }

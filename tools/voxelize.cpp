@@ -39,7 +39,7 @@ static cli::Usage usage() {
       {"centre", "X,Y,Z", "also voxelize centre +- offset at depth 1 (repeat for several: one batched pass)", "", true},
       {"offset", "M", "half edge of the deeper grids, metres", "0.15"},
       {"octomap-channels", "", "add the free and unknown channels (12 in all)", ""},
-      {"png", "DIR", "save a picture of every grid as DIR/<record>.depth<d>[.<k>].png", ""},
+      {"png", "DIR", "save a picture of every grid as DIR/<record>.depth<d>[.<k>].png (all at the end, or none)", ""},
   };
   u.options.push_back(cli::output_file());
   u.add_options(voxels::scene_options());
@@ -62,14 +62,15 @@ static void run(const cli::Arguments& args) {
     const auto p = cli::parse_reals("centre", c, 3);
     crops.push_back(voxels::GridBounds::around({p[0], p[1], p[2]}, offset, scene.voxels));
   }
-  const std::string png_dir = args.text("png");
-  if (!png_dir.empty()) make_output_directory(png_dir);
+  std::unique_ptr<OutputDirectory> pictures;  // all or none
+  if (args.has("png")) pictures = std::make_unique<OutputDirectory>(args.text("png"));
 
-  voxels::VoxelizeStage stage({scene, crops, args.flag("octomap-channels")}, png_dir,
+  voxels::VoxelizeStage stage({scene, crops, args.flag("octomap-channels")}, pictures ? pictures->staging() : "",
                               point_clouds::observation_filter(point_clouds::parse_cloud_filters(args)));
   stream::RecordReader reader(args.input());
   stream::RecordWriter writer(args.text("output"));
   stream::run_stage(stage, reader, writer);
+  if (pictures) pictures->commit();
 }
 
 int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }

@@ -30,6 +30,8 @@ static cli::Usage usage() {
       "naming the record and the reason; a 'trajectory' that holds only a planner failure has no "
       "motion and is skipped with a line on standard error. examples/xarm_play.py plays the "
       "files on the arm with UFACTORY's Python SDK.",
+      "The files appear all or none: a run that fails (a path refused, damaged input) leaves DIR "
+      "as it was, so no arm is given the first moves of an episode whose later ones were refused.",
   };
   u.arguments = {cli::input_files("record streams")};
   u.options = {
@@ -49,7 +51,7 @@ static void run(const cli::Arguments& args) {
   const std::vector<std::string> files = args.inputs();
   const std::string dir = args.text("dir");
   const double rate = args.real("rate", 1, 1000), settle = args.real("settle", 0, 60);
-  make_output_directory(dir);
+  OutputDirectory out(dir);
   const robot::RobotModel robot = robot::RobotModel::xarm7();
   double gripper_m = robot.max_finger_opening_m();  // open until an observation says otherwise
   for (const std::string& file : files) {
@@ -76,15 +78,16 @@ static void run(const cli::Arguments& args) {
         throw StreamError(record->position, e.what());
       }
       char name[32];
-      std::snprintf(name, sizeof name, "/%06llu.xarm.csv", index);
+      std::snprintf(name, sizeof name, "%06llu.xarm.csv", index);
       const std::string comment = "# xArm 7 joint trajectory: " + file + ", record " + std::to_string(index) +
                                   "\n# rows every " + std::to_string(1.0 / rate) +
                                   " s; joints in degrees; gripper 0 (closed) .. 850 (open)\n";
       const std::string csv = robot::xarm_csv(rows, comment);
-      write_file_atomically(dir + name, csv.data(), csv.size());
+      out.write_file(name, csv.data(), csv.size());
       gripper_m = after_m;
     }
   }
+  out.commit();
 }
 
 int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }

@@ -171,6 +171,27 @@ double Arguments::real(const std::string& name, double lo, double hi) const {
   return x;
 }
 
+std::pair<double, double> Arguments::range(const std::string& name) const {
+  const std::vector<double> v = parse_reals(name, text(name), 2);
+  if (!(v[0] < v[1])) throw UsageError("--" + name + ": expected LO,HI with LO < HI, got '" + text(name) + "'");
+  return {v[0], v[1]};
+}
+
+std::pair<int, int> Arguments::size(const std::string& name, int min_width, int min_height, int max_width,
+                                    int max_height) const {
+  const std::string v = text(name);
+  const std::size_t x = v.find('x');
+  const auto whole_number = [](const std::string& digits) {
+    return !digits.empty() && digits.size() <= 9 && digits.find_first_not_of("0123456789") == std::string::npos;
+  };
+  if (x != std::string::npos && whole_number(v.substr(0, x)) && whole_number(v.substr(x + 1))) {
+    const int width = std::stoi(v.substr(0, x)), height = std::stoi(v.substr(x + 1));
+    if (width >= min_width && width <= max_width && height >= min_height && height <= max_height) return {width, height};
+  }
+  throw UsageError("--" + name + ": expected WxH between " + std::to_string(min_width) + "x" + std::to_string(min_height) +
+                   " and " + std::to_string(max_width) + "x" + std::to_string(max_height) + ", got '" + v + "'");
+}
+
 std::size_t Arguments::choice(const std::string& name, const std::vector<std::string>& choices) const {
   const std::string v = text(name);
   std::string listed;

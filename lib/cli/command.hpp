@@ -61,12 +61,14 @@ class Arguments {
   bool flag(const std::string& name) const;
   bool has(const std::string& name) const;  // given on the command line
   std::string text(const std::string& name) const;
-  int64_t integer(const std::string& name) const;
-  // The same, refused with a UsageError outside lo..hi (no value wraps when a tool narrows it).
+  // Every number from a user is range-checked here: an integer outside lo..hi (no value wraps
+  // when a tool narrows it), or a real that is not finite or outside lo..hi, is a UsageError.
   int64_t integer(const std::string& name, int64_t lo, int64_t hi) const;
-  double real(const std::string& name) const;
-  // The same, refused with a UsageError unless finite and within lo..hi.
   double real(const std::string& name, double lo, double hi) const;
+  // "LO,HI": two finite numbers, LO < HI.
+  std::pair<double, double> range(const std::string& name) const;
+  // "WxH" with W in min_width..max_width and H in min_height..max_height.
+  std::pair<int, int> size(const std::string& name, int min_width, int min_height, int max_width, int max_height) const;
   // The index of the option's value in `choices`, or a UsageError listing them.
   std::size_t choice(const std::string& name, const std::vector<std::string>& choices) const;
   // Exactly `count` comma-separated finite numbers ("0.1,0,0.8"), or a UsageError naming the option.
@@ -77,9 +79,11 @@ class Arguments {
   std::vector<std::string> inputs() const {
     return positional_.empty() ? std::vector<std::string>{"-"} : positional_;
   }
-  uint64_t seed() const { return static_cast<uint64_t>(integer("seed")); }
+  uint64_t seed() const { return static_cast<uint64_t>(integer("seed", 0, INT64_MAX)); }
 
  private:
+  int64_t integer(const std::string& name) const;
+  double real(const std::string& name) const;
   friend Arguments parse(const Usage& usage, const std::vector<std::string>& argv);
   const Usage* usage_ = nullptr;
   std::map<std::string, std::vector<std::string>> given_;

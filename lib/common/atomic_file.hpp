@@ -2,7 +2,9 @@
 // renames to <path>. A destructor without commit(), SIGINT, SIGTERM or SIGHUP removes the
 // temporary file, so a failed or interrupted tool never leaves a half file under the final name.
 // A path that exists and is not a regular file (/dev/null, a FIFO, a terminal) is written
-// directly: renaming over it would replace the device or pipe with a file.
+// directly: renaming over it would replace the device or pipe with a file. A path that is a
+// symbolic link is followed: the file it names is replaced (atomically, beside that file), the
+// link stays, as a shell's `>` would do; a dangling link's target is created.
 #pragma once
 
 #include <cstddef>
@@ -25,7 +27,8 @@ class AtomicOutputFile {
   const std::string& path() const { return path_; }
 
  private:
-  std::string path_;
+  std::string path_;         // as given (messages name it)
+  std::string target_path_;  // where the bytes go: path_, or the file a symbolic link names
   std::string temp_path_;
   int fd_ = -1;
 };
@@ -40,8 +43,33 @@ void write_all(int fd, const void* data, std::size_t n, const std::string& what)
 int remove_stale_temporaries(const std::string& dir, const std::string& name = "");
 
 // Creates the directory `path` where output files go, unless it exists (parents are not made).
-// Throws Error naming it otherwise.
-void make_output_directory(const std::string& path);
+// Throws Error naming it otherwise. Returns true when it created it.
+bool make_output_directory(const std::string& path);
+
+// The files of a program that writes several (pictures, joint files, arrays) appear all or none:
+// they are written into a staging directory inside DIR (DIR/.qte-staging.tmp.<pid>, so libraries
+// that write to a path can be given staging()), and commit() moves them into DIR. Without
+// commit() (an error, SIGINT, SIGTERM, SIGHUP) the staging directory is removed, DIR keeps the
+// files it had, and DIR itself is removed again when this run created it; what a SIGKILL left
+// is removed by the next writer into DIR.
+class OutputDirectory {
+ public:
+  explicit OutputDirectory(std::string dir);
+  ~OutputDirectory();
+  OutputDirectory(const OutputDirectory&) = delete;
+  OutputDirectory& operator=(const OutputDirectory&) = delete;
+
+  // Where files are written until commit().
+  const std::string& staging() const { return staging_; }
+  std::string path(const std::string& name) const { return staging_ + "/" + name; }
+  void write_file(const std::string& name, const void* data, std::size_t n);
+  // Moves every staged file into DIR (in name order) and removes the staging directory.
+  void commit();
+
+ private:
+  std::string dir_, staging_;
+  bool created_dir_ = false, committed_ = false;
+};
 
 // Convenience: the whole file at once, atomically.
 void write_file_atomically(const std::string& path, const void* data, std::size_t n);

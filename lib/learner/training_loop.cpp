@@ -2,8 +2,11 @@
 
 #include <sys/stat.h>
 
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <ostream>
 #include <random>
@@ -37,15 +40,26 @@ std::string csv_header(int depths, bool adaptive_tree) {
   return h;
 }
 
-// Keeps the rows of an earlier run up to `step` (a resumed run rewrites what follows).
+// Keeps the rows of an earlier run up to `step` (a resumed run rewrites what follows); a fresh
+// run (step < 0) starts the file anew without reading what was there, and only a regular file
+// is read (not a device or a pipe someone named).
 void trim_metrics(const std::string& path, int64_t step, const std::string& header) {
-  std::ifstream in(path);
   std::string text = header + "\n";
-  if (in) {
-    std::string line;
-    std::getline(in, line);
-    while (std::getline(in, line))
-      if (!line.empty() && std::stoll(line.substr(0, line.find(','))) <= step) text += line + "\n";
+  std::ifstream in;
+  std::error_code ignored;
+  if (step >= 0 && std::filesystem::is_regular_file(path, ignored)) in.open(path);
+  std::string line;
+  if (in) std::getline(in, line);
+  for (int64_t row = 2; in && std::getline(in, line); ++row) {
+    if (line.empty()) continue;
+    const std::string first = line.substr(0, line.find(','));
+    char* end = nullptr;
+    errno = 0;
+    const long long row_step = std::strtoll(first.c_str(), &end, 10);
+    if (first.empty() || *end != '\0' || errno != 0)
+      throw Error(path + ": line " + std::to_string(row) + ": expected a step number in the first column " +
+                  "(a metrics CSV written by qattn-train), found '" + first.substr(0, 24) + "'");
+    if (row_step <= step) text += line + "\n";
   }
   AtomicOutputFile file(path);
   file.write(text.data(), text.size());
@@ -141,14 +155,31 @@ bool TrainingLoop::start(bool resume) {
               << " transitions\n";
     resumed = true;
   } else {
-    save();
     fresh_ = true;
   }
+  // The metrics file before the first checkpoint: a --metrics that cannot be written leaves no
+  // checkpoint behind.
   if (!options_.metrics_path.empty()) {
     trim_metrics(options_.metrics_path, resumed ? learner_.step() : -1, header);
     metrics_.open(options_.metrics_path, std::ios::app);
   }
+  if (!resumed) {
+    try {
+      save();
+    } catch (...) {
+      discard_metrics();
+      throw;
+    }
+  }
   return resumed;
+}
+
+// A fresh run's metrics file goes with its initial checkpoint (never a device like /dev/null).
+void TrainingLoop::discard_metrics() {
+  metrics_.close();
+  std::error_code ignored;
+  if (!options_.metrics_path.empty() && std::filesystem::is_regular_file(options_.metrics_path, ignored))
+    std::filesystem::remove(options_.metrics_path, ignored);
 }
 
 void TrainingLoop::run() {
@@ -157,8 +188,7 @@ void TrainingLoop::run() {
   } catch (...) {
     if (only_initial_weights_saved()) {
       checkpoints_.discard(0);
-      metrics_.close();
-      if (!options_.metrics_path.empty()) std::filesystem::remove(options_.metrics_path);
+      discard_metrics();
     }
     throw;
   }

@@ -69,6 +69,7 @@ class TrainingLoop {
   void ingest(int64_t agent_limit, bool fill_to_start_after, int64_t total_limit = INT64_MAX);
   void train();
   void save();
+  void discard_metrics();
   void log_row(const StepStats& stats);
 
   QLearner& learner_;

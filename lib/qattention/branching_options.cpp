@@ -24,12 +24,10 @@ Branching parse_branching(const cli::Arguments& args, const std::string& k_optio
   if (margin == mass) throw UsageError("--" + k_option + " auto needs one of --k-margin and --k-mass");
   const int k_max = static_cast<int>(args.integer("k-max", 1, 4096));
   if (margin) {
-    const double m = args.real("k-margin");
-    if (!(m >= 0 && std::isfinite(m))) throw UsageError("--k-margin must be a non-negative number");
+    const double m = args.real("k-margin", 0, 1e30);
     return Branching::within_margin(static_cast<float>(m), k_max);
   }
-  const double p = args.real("k-mass");
-  if (!(p > 0 && p <= 1)) throw UsageError("--k-mass must be in (0, 1]");
+  const double p = args.real("k-mass", 1e-9, 1);
   return Branching::softmax_mass(static_cast<float>(p), k_max);
 }
 

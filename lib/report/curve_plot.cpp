@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -14,6 +15,9 @@ namespace {
 
 // ---------------------------------------------------------------------------------------------
 // Axes: round tick values within the data range
+
+// A picture's bound: 100 megapixels are 300 MB of colour before encoding.
+constexpr double kMaxPicturePixels = 100e6;
 
 struct Axis {
   double lo = 0, hi = 1;
@@ -30,11 +34,23 @@ double round_step(double raw) {
   return (f < 1.5 ? 1 : f < 3 ? 2 : f < 7 ? 5 : 10) * power;
 }
 
+// An axis whose extent is not finite (values near the ends of the double range), or is below
+// what doubles resolve at its values, has no round ticks to count up to its end.
+void check_axis(const char* name, const Axis& axis) {
+  const double extent = axis.hi - axis.lo, size = std::max(std::fabs(axis.lo), std::fabs(axis.hi));
+  if (!std::isfinite(extent) || !(extent > 1e-9 * size)) {
+    std::ostringstream text;
+    text << "the " << name << " axis from " << axis.lo << " to " << axis.hi
+         << " cannot be drawn (expected finite values spanning more than 1e-9 of their size)";
+    throw Error(text.str());
+  }
+}
+
 void set_ticks(Axis& axis, int target) {
   axis.step = round_step((axis.hi - axis.lo) / std::max(1, target));
   axis.ticks.clear();
   const double first = std::ceil(axis.lo / axis.step - 1e-9);
-  for (double k = first;; ++k) {
+  for (double k = first; axis.ticks.size() < 1000; ++k) {  // a round step over a checked extent: a few dozen
     double v = k * axis.step;
     if (v > axis.hi + 1e-9 * axis.step) break;
     if (std::fabs(v) < 1e-12 * axis.step) v = 0;  // no "-0"
@@ -350,21 +366,14 @@ struct Extent {
   }
 };
 
-// Values near the ends of the double range have no finite extent to draw (ticks would never end).
-void check_extent(const char* axis, double lo, double hi) {
-  if (!std::isfinite(hi - lo) || !std::isfinite(0.04 * (hi - lo) + hi) || !std::isfinite(lo - 0.04 * (hi - lo)))
-    throw Error(std::string("the ") + axis + " values span " + std::to_string(lo) + " to " + std::to_string(hi) +
-                ": more than a plot can draw");
-}
-
 // The vertical axis of `extent`'s data and bands, or the fixed range.
 Axis y_axis_of(const Extent& extent, const CurvePlotOptions& options) {
-  check_extent("y", options.fixed_y ? options.y_min : extent.y_lo, options.fixed_y ? options.y_max : extent.y_hi);
   Axis y_axis = data_axis(extent.y_lo, extent.y_hi);
   if (options.fixed_y) {
     y_axis.lo = options.y_min;
     y_axis.hi = options.y_max;
   }
+  check_axis("y", y_axis);
   return y_axis;
 }
 
@@ -373,9 +382,10 @@ cv::Mat draw_curves(const std::vector<Curve>& curves, const std::vector<cv::Scal
                     const std::string& title, const CurvePlotOptions& options) {
   Extent extent;
   extent.add(curves);
-  check_extent("x", extent.x_lo, extent.x_hi);
+  const Axis x_axis = data_axis(extent.x_lo, extent.x_hi);
+  check_axis("x", x_axis);
   const Labels labels{title, options.x_label, options.y_label, options.legend, colours};
-  return draw(curves, data_axis(extent.x_lo, extent.x_hi), y_axis, labels,
+  return draw(curves, x_axis, y_axis, labels,
               cv::Size(options.width_px, options.height_px));
 }
 
@@ -404,6 +414,12 @@ cv::Mat draw_panels(const std::vector<CurvePanel>& panels, const CurvePlotOption
   const int n = static_cast<int>(panels.size());
   columns = std::clamp(columns, 1, n);
   const int rows = (n + columns - 1) / columns;
+  const double pixels = double(rows) * options.height_px * double(columns) * options.width_px;
+  if (pixels > kMaxPicturePixels)
+    throw Error(std::to_string(n) + " panels of " + std::to_string(options.width_px) + "x" +
+                std::to_string(options.height_px) + " make a picture of " + std::to_string(int64_t(pixels / 1e6)) +
+                " megapixels (at most " + std::to_string(int64_t(kMaxPicturePixels / 1e6)) +
+                "): fewer panels (--panel) or a smaller --size");
   // The picture's title a size above the panels' own.
   const Style style = style_for(cv::Size(options.width_px, options.height_px));
   const double title_scale = style.title_scale * 1.3;

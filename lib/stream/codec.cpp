@@ -20,7 +20,6 @@ constexpr bool kVerifyChecksums = true;
 #endif
 
 constexpr std::size_t kDescriptorFixedBytes = 16;
-constexpr int64_t kMaxExtent = int64_t(1) << 40;
 
 std::size_t pad64(std::size_t n) { return (n + kAlignment - 1) / kAlignment * kAlignment; }
 
@@ -174,14 +173,9 @@ Record decode_payload(const RecordHeader& header, std::shared_ptr<const uint8_t>
     const uint64_t descriptor_bytes = pad64(kDescriptorFixedBytes + 8 * ndim + name_len);
     if (size - at < descriptor_bytes) throw bad("descriptor runs past the payload end");
     Shape shape(ndim);
-    int64_t count = 1;
-    for (int k = 0; k < ndim; ++k) {
-      shape[k] = load<int64_t>(d + kDescriptorFixedBytes + 8 * k);
-      if (shape[k] < 0 || shape[k] > kMaxExtent)
-        throw bad("extent " + std::to_string(shape[k]) + " in dimension " + std::to_string(k));
-      if (shape[k] != 0 && count > kMaxExtent / shape[k]) throw bad("more than 2^40 elements");
-      count *= shape[k];
-    }
+    for (int k = 0; k < ndim; ++k) shape[k] = load<int64_t>(d + kDescriptorFixedBytes + 8 * k);
+    if (const std::string why = shape_problem(shape); !why.empty()) throw bad(why);
+    const int64_t count = element_count(shape);
     std::string name(reinterpret_cast<const char*>(d + kDescriptorFixedBytes + 8 * ndim),
                      name_len);
     if (!is_valid_field_name(name)) throw bad("invalid field name (expected [A-Za-z0-9_.-])");

@@ -45,6 +45,8 @@ void add_numbers(Record& record, const std::string& name, const Shape& shape,
                   dtype_name(dtype_of<T>()));
     }
   }
+  if (const std::string why = shape_problem(shape); !why.empty())
+    throw Error("field spec '" + spec + "': shape " + shape_to_string(shape) + ": " + why);
   if (element_count(shape) != static_cast<int64_t>(values.size()))
     throw Error("field spec '" + spec + "': shape " + shape_to_string(shape) + " needs " +
                 std::to_string(element_count(shape)) + " values, got " +

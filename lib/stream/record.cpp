@@ -26,6 +26,20 @@ int64_t element_count(const Shape& shape) {
   return n;
 }
 
+std::string shape_problem(const Shape& shape) {
+  constexpr int64_t kMaxElements = int64_t(1) << 40;
+  if (shape.size() > static_cast<std::size_t>(kMaxDims))
+    return "ndim " + std::to_string(shape.size()) + " (expected at most " + std::to_string(kMaxDims) + ")";
+  int64_t count = 1;
+  for (std::size_t k = 0; k < shape.size(); ++k) {
+    if (shape[k] < 0 || shape[k] > kMaxElements)
+      return "extent " + std::to_string(shape[k]) + " in dimension " + std::to_string(k);
+    if (shape[k] != 0 && count > kMaxElements / shape[k]) return "more than 2^40 elements";
+    count *= shape[k];
+  }
+  return "";
+}
+
 std::string shape_to_string(const Shape& shape) {
   std::string s = "[";
   for (std::size_t i = 0; i < shape.size(); ++i) s += (i ? ", " : "") + std::to_string(shape[i]);
@@ -61,6 +75,8 @@ Record::Record(std::string type) : type_(std::move(type)) {
 }
 
 void Record::check_count(const std::string& name, const Shape& shape, std::size_t count) {
+  if (const std::string why = shape_problem(shape); !why.empty())
+    throw Error("field '" + name + "': shape " + shape_to_string(shape) + ": " + why);
   if (element_count(shape) != static_cast<int64_t>(count))
     throw Error("field '" + name + "': shape " + shape_to_string(shape) + " needs " +
                 std::to_string(element_count(shape)) + " values, got " + std::to_string(count));
@@ -70,9 +86,8 @@ void Record::set_raw(const std::string& name, DType dtype, const Shape& shape, c
                      bool compress) {
   if (!is_valid_field_name(name))
     throw Error("invalid field name '" + name + "' (expected 1-255 characters of [A-Za-z0-9_.-])");
-  if (shape.size() > kMaxDims) throw Error("field '" + name + "': more than 8 dimensions");
-  for (int64_t d : shape)
-    if (d < 0) throw Error("field '" + name + "': negative extent in " + shape_to_string(shape));
+  if (const std::string why = shape_problem(shape); !why.empty())
+    throw Error("field '" + name + "': shape " + shape_to_string(shape) + ": " + why);
   auto storage = aligned_copy(data, element_count(shape) * dtype_size(dtype));
   Field field(name, dtype, shape, storage, storage.get());
   field.compress = compress;

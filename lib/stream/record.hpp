@@ -17,6 +17,9 @@ using Shape = std::vector<int64_t>;
 
 // Number of elements of a shape (1 for a scalar).
 int64_t element_count(const Shape& shape);
+// Why `shape` cannot be a field's (more than 8 dimensions, an extent below 0 or above 2^40, more
+// than 2^40 elements), or "" when it can: one rule for the writers and the decoder.
+std::string shape_problem(const Shape& shape);
 std::string shape_to_string(const Shape& shape);  // "[128, 128, 3]"
 
 // Read-only typed view of a field's elements, stored C order (row-major).

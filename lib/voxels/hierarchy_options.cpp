@@ -64,7 +64,7 @@ std::vector<cli::OptionSpec> checkpoint_hierarchy_options() {
 CoarseToFine checkpoint_hierarchy(const cli::Arguments& args, const std::optional<CoarseToFine>& trained, int voxels,
                                   int depths, const std::string& checkpoint) {
   const auto agree = [&](const char* option, int checkpoint_value) {
-    if (args.has(option) && args.integer(option) != checkpoint_value)
+    if (args.has(option) && args.integer(option, 1, 1 << 20) != checkpoint_value)
       throw UsageError(std::string("--") + option + " " + args.text(option) + " differs from the checkpoint's " +
                        std::to_string(checkpoint_value) + " (" + checkpoint + ")");
   };

@@ -41,10 +41,15 @@ grep -q "the learner (qattn-train, pid $learner) died, killed by signal KILL; la
 sleep 1
 pgrep -f "$run" > /dev/null && fail "programs of the run still running: $(pgrep -af "$run")"
 
-# 2. Resume with a budget this run has nearly spent: it ends by itself, with an evaluation.
+# 2. Resume with a budget this run has nearly spent: it ends by itself, with an evaluation. The
+# replay first gets a torn last record, as an append killed half-way leaves: it is cut off.
+replay_bytes=$(stat -c %s "$run/replay.rec")
+head -c 100 "$run/replay.rec" >> "$run/replay.rec"
 spent=$(awk -v t="$(getconf CLK_TCK)" '{ print int(($1 + $2 + $3 + $4 + $5) / t) }' "$run/cpu_ticks")
 CPU_BUDGET=$(( spent + 3 )) ALSO_ACT_K=1,2 bash "$learn" reach_target "$run" 2> "$tmp/resume.log" \
   || fail "the resumed run failed: $(tail -5 "$tmp/resume.log")"
+grep -q "repaired $run/replay.rec: record [0-9]* at byte $replay_bytes: cut off 100 bytes" "$tmp/resume.log" \
+  || fail "the torn record was not cut off: $(grep -i repair "$tmp/resume.log")"
 [ -f "$run/eval.csv" ] || fail "no eval.csv"
 # The final networks acting with another K as well (ALSO_ACT_K; its own K = 1 is failures.csv).
 [ -f "$run/failures.csv" ] && [ -f "$run/failures-act-k2.csv" ] && [ ! -f "$run/failures-act-k1.csv" ] \

@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdint>
+
 #include "cli/command.hpp"
 #include "common/error.hpp"
 
@@ -21,13 +24,13 @@ cli::Usage usage() {
 TEST(Command, ParsesOptionsDefaultsAndPositionals) {
   const auto u = usage();
   auto a = cli::parse(u, {"--k", "5", "x.rec", "--json", "--type=obs", "--type", "action", "-"});
-  EXPECT_EQ(a.integer("k"), 5);
+  EXPECT_EQ(a.integer("k", 1, 100), 5);
   EXPECT_TRUE(a.flag("json"));
   EXPECT_EQ(a.all("type"), (std::vector<std::string>{"obs", "action"}));
   EXPECT_EQ(a.positional(), (std::vector<std::string>{"x.rec", "-"}));
   EXPECT_EQ(a.seed(), 0u);
   auto b = cli::parse(u, {"--seed", "42"});
-  EXPECT_EQ(b.integer("k"), 10);
+  EXPECT_EQ(b.integer("k", 1, 100), 10);
   EXPECT_EQ(b.seed(), 42u);
 }
 
@@ -39,7 +42,28 @@ TEST(Command, RejectsBadUsage) {
   EXPECT_THROW(cli::parse(u, {"--k", "1", "--k", "2"}), UsageError);
   EXPECT_THROW(cli::parse(u, {"--json=yes"}), UsageError);
   EXPECT_THROW(cli::parse(u, {"--seed", "x"}), UsageError);
-  EXPECT_THROW(cli::parse(u, {"--k", "ten"}).integer("k"), UsageError);
+  EXPECT_THROW(cli::parse(u, {"--k", "ten"}).integer("k", 1, 100), UsageError);
+  EXPECT_THROW(cli::parse(u, {"--seed", "-1"}), UsageError);
+}
+
+// Numbers are range-checked where they are read: nothing wraps, nothing non-finite passes.
+TEST(Command, NumbersSizesAndRangesAreBounded) {
+  cli::Usage u = usage();
+  u.options.push_back({"size", "WxH", "picture size", "800x500"});
+  u.options.push_back({"y-range", "LO,HI", "axis", "0,1"});
+  u.options.push_back({"rate", "R", "rate", "0.5"});
+  const auto parse = [&](std::vector<std::string> argv) { return cli::parse(u, argv); };
+  EXPECT_EQ(parse({"--size", "640x480"}).size("size", 200, 150, 10000, 10000), std::make_pair(640, 480));
+  for (const char* bad : {"4294967496x300", "-640x480", "640x", "640x480x2", "640X480", "0x0", "640x100", " 640x480"})
+    EXPECT_THROW(parse({"--size", bad}).size("size", 200, 150, 10000, 10000), UsageError) << bad;
+  EXPECT_EQ(parse({"--y-range", "-1,2.5"}).range("y-range"), std::make_pair(-1.0, 2.5));
+  for (const char* bad : {"1,1", "2,1", "0,inf", "nan,1", "0", "0,1,2", "0,1e999"})
+    EXPECT_THROW(parse({"--y-range", bad}).range("y-range"), UsageError) << bad;
+  EXPECT_THROW(parse({"--k", "4294967297"}).integer("k", 1, 100), UsageError);
+  EXPECT_THROW(parse({"--k", "99999999999999999999"}).integer("k", 1, INT64_MAX), UsageError);
+  EXPECT_THROW(parse({"--rate", "-0.1"}).real("rate", 0, 1), UsageError);
+  EXPECT_THROW(parse({"--rate", "nan"}).real("rate", 0, 1), UsageError);
+  EXPECT_THROW(parse({"--rate", "inf"}).real("rate", 0, INFINITY), UsageError);
 }
 
 TEST(Command, HelpAndManPageCoverEveryOption) {

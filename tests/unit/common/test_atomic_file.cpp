@@ -4,10 +4,14 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 
+#include <algorithm>
+#include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <thread>
+#include <vector>
 
 #include "common/atomic_file.hpp"
 #include "stream/writer.hpp"
@@ -129,4 +133,97 @@ TEST(OutputDirectory, MadeOrReusedButNeverAFile) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find(dir + "/file: exists and is not a directory"), std::string::npos) << e.what();
   }
+}
+
+namespace {
+std::string listing(const std::string& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  std::string text;
+  for (const auto& name : names) text += name + " ";
+  return text;
+}
+std::string contents(const std::string& path) {
+  std::ifstream in(path);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+}  // namespace
+
+// Several files appear all or none: before commit() nothing is in DIR; abandoned, DIR keeps what
+// it had (an old file of the same name included) and a DIR the run created goes again.
+TEST(OutputDirectory, FilesAppearAllOrNone) {
+  const std::string dir = temp_dir(), out = dir + "/pictures";
+  {
+    OutputDirectory pictures(out);
+    pictures.write_file("0.png", "a", 1);
+    write_file_atomically(pictures.path("1.png"), "b", 1);  // as a library given a path writes
+    EXPECT_EQ(listing(out), ".qte-staging.tmp." + std::to_string(::getpid()) + " ");
+  }
+  EXPECT_FALSE(exists(out)) << "a directory this run created stays behind a failure";
+  make_output_directory(out);
+  std::ofstream(out + "/0.png") << "old";
+  {
+    OutputDirectory pictures(out);
+    pictures.write_file("0.png", "new", 3);
+    pictures.write_file("2.png", "c", 1);
+  }
+  EXPECT_EQ(listing(out), "0.png ");
+  EXPECT_EQ(contents(out + "/0.png"), "old");
+  {
+    OutputDirectory pictures(out);
+    pictures.write_file("0.png", "new", 3);
+    pictures.write_file("2.png", "c", 1);
+    pictures.commit();
+  }
+  EXPECT_EQ(listing(out), "0.png 2.png ");
+  EXPECT_EQ(contents(out + "/0.png"), "new");
+}
+
+// A signal while files are staged removes them and the directory the run made; a SIGKILL's
+// staging directory is removed by the next writer into DIR.
+TEST(OutputDirectory, SignalsAndKillsLeaveNothing) {
+  const std::string dir = temp_dir(), out = dir + "/signalled";
+  for (int signal_number : {SIGTERM, SIGKILL}) {
+    int ready[2];
+    ASSERT_EQ(::pipe(ready), 0);
+    const pid_t child = ::fork();
+    if (child == 0) {
+      OutputDirectory pictures(out);
+      for (int i = 0; i < 100; ++i) pictures.write_file(std::to_string(i) + ".png", "x", 1);
+      (void)!::write(ready[1], "r", 1);
+      ::pause();
+      ::_exit(0);
+    }
+    char c;
+    ASSERT_EQ(::read(ready[0], &c, 1), 1);
+    ::close(ready[0]), ::close(ready[1]);
+    ::kill(child, signal_number);
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    ASSERT_TRUE(WIFSIGNALED(status));
+    if (signal_number == SIGTERM) {
+      EXPECT_FALSE(exists(out)) << listing(out);
+    } else {
+      ASSERT_EQ(listing(out), ".qte-staging.tmp." + std::to_string(child) + " ");
+      OutputDirectory next(out);
+      next.write_file("a.png", "y", 1);
+      next.commit();
+      EXPECT_EQ(listing(out), "a.png ");
+    }
+  }
+}
+
+// An output that is a symbolic link is followed: its target gets the bytes, the link stays (a
+// dangling link's target is made).
+TEST(AtomicFile, SymbolicLinksAreFollowed) {
+  const std::string dir = temp_dir();
+  std::filesystem::create_directory(dir + "/disk");
+  std::filesystem::create_symlink("disk/replay.rec", dir + "/replay.rec");
+  for (const char* text : {"first", "second"}) {
+    write_file_atomically(dir + "/replay.rec", text, std::strlen(text));
+    EXPECT_TRUE(std::filesystem::is_symlink(dir + "/replay.rec"));
+    EXPECT_EQ(contents(dir + "/disk/replay.rec"), text);
+  }
+  EXPECT_EQ(listing(dir + "/disk"), "replay.rec ");
 }
