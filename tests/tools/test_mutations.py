@@ -188,6 +188,9 @@ def check(program, description, argv, data, output=None, stdout_stream=True, wor
             failures.append(f"{label}: exit 1 but not one positioned line: {err[-400:]!r}")
         if output and os.path.exists(output):
             failures.append(f"{label}: exit 1 left {output} behind")
+        for directory in (png_dir, xarm_dir, npy_dir):  # several files: all or none
+            if os.path.exists(directory):
+                failures.append(f"{label}: exit 1 left {directory} behind: {sorted(os.listdir(directory))[:5]}")
     else:
         if output and os.path.isdir(output):  # a checkpoint directory
             output = os.path.join(output, "latest.rec")
@@ -204,7 +207,7 @@ def check(program, description, argv, data, output=None, stdout_stream=True, wor
     for name in os.listdir(tmp):  # nothing of ours beside the inputs
         if ".tmp." in name:
             failures.append(f"{label}: temporary {name} left in the output directory")
-    for made_here in (out, png_dir, ckpt_out, video, xarm_dir):
+    for made_here in (out, png_dir, ckpt_out, video, xarm_dir, npy_dir):
         subprocess.run(["rm", "-rf", made_here])
 
 
@@ -245,10 +248,12 @@ png_dir = os.path.join(tmp, "png")
 ckpt_out = os.path.join(tmp, "ckpt-out")
 video = os.path.join(tmp, "episode.mp4")
 xarm_dir = os.path.join(tmp, "xarm")
+npy_dir = os.path.join(tmp, "npy")
 trajectory_index = [i for i, r in enumerate(planned_recs) if r[0] == "trajectory"][0]
 runs = [
     # program, argv (INPUT: the mutated file), records to mutate, which of them, output file, stream on stdout?
     ("stream-dump", ["INPUT"], acted_recs, [0, 1], None, False),
+    ("stream-dump", ["--summary", "--npy", npy_dir, "--pcd", npy_dir, "INPUT"], obs_recs[:2], [0, 1], None, False),
     ("stream-cat", ["INPUT", "--output", out], acted_recs, [1], out, False),
     ("episode-stats", ["INPUT"], obs_recs[:3], [1], None, False),
     ("stream-png", ["--depth", "--dir", png_dir, "INPUT"], obs_recs[:1], [0], None, False),
@@ -280,6 +285,103 @@ for description, data in sample(cases(ckpt_recs, [0]), "checkpoint"):
     check("qte-select", "checkpoint " + description,
           ["--checkpoint", os.path.join(tmp, "bad-checkpoint.rec"), "--k", "2", "INPUT"], first_obs, None, True)
     ran += 1
+
+
+# Cameras that see nothing, and matrices that are not a camera's: refused with one positioned line
+# or passed on (the general rule above); qte-select never chooses an action on such a scene.
+def camera_cases(recs, index):
+    rtype, fields = recs[index]
+    cameras = [n[: -len(".intrinsics")] for n in fields if n.endswith(".intrinsics")]
+
+    def changed(what, edit):
+        new = {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in fields.items()}
+        for camera in cameras:
+            edit(new[camera + ".intrinsics"], new[camera + ".extrinsics"])
+            if what.startswith("every camera") and camera + ".points" in new:  # the stored points with it
+                new[camera + ".points"] = new[camera + ".points"] + np.float32(100.0)
+        out = list(recs)
+        out[index] = (rtype, new)
+        return what, lambda out=out: stream(out)
+
+    def far_away(K, E):
+        E[:3, 3] += 100.0
+
+    yield changed("every camera 100 m away (nothing seen)", far_away)
+    yield changed("zero focal lengths", lambda K, E: K.__setitem__((slice(0, 2), slice(0, 2)), 0))
+    yield changed("negative focal length", lambda K, E: K.__setitem__((0, 0), -K[0, 0]))
+    yield changed("singular extrinsic rotation", lambda K, E: E.__setitem__((slice(0, 3), slice(0, 3)), 0))
+    yield changed("a reflection, not a rotation", lambda K, E: E.__setitem__((slice(0, 3), 0), -E[:3, 0]))
+    yield changed("turned round (looking away)", lambda K, E: E.__setitem__((slice(0, 3), slice(1, 3)), -E[:3, 1:3]))
+
+
+camera_runs = [
+    ("qte-select", ["--checkpoint", checkpoint, "--k", "2", "--seed", "1", "INPUT"], acted_recs[:1], 0, True),
+    ("voxelize", ["INPUT"], obs_recs[:1], 0, False),
+    ("plan-path", ["--seed", "1", "INPUT"], acted_recs, 0, False),
+    ("qattn-train", ["--steps", "1", "--start-after", "0", "--seed", "1", "--checkpoint-dir", ckpt_out, "INPUT"],
+     transition_recs, first_of(transition_recs, "frame")[0], False),
+]
+for program, argv, recs, index, must_refuse_empty in camera_runs:
+    for description, data in camera_cases(recs, index):
+        before = len(failures)
+        check(program, "camera " + description, argv, data(), ckpt_out if program == "qattn-train" else None, True)
+        ran += 1
+        if must_refuse_empty and "nothing seen" in description and len(failures) == before:
+            r = tool(program, *[a.replace("INPUT", os.path.join(tmp, "input.rec")) for a in argv])
+            if r.returncode != 1:
+                failures.append(f"{program} [camera {description}]: exit {r.returncode}: an action chosen on an empty scene")
+
+# Appends onto foreign bytes, a torn last record, damage, or the input itself: exit 0 with the old
+# bytes kept as the start of a readable stream, or exit 1 with one positioned line and the file as
+# it was.
+whole = stream(obs_recs[:2])
+appended_to = {
+    "foreign bytes": b"this is not a record stream, only some text. " * 4,
+    "a torn last record": whole[: len(whole) - 37],
+    "a damaged first header": whole[:3] + bytes([whole[3] ^ 0xFF]) + whole[4:],
+    "a whole stream": whole,
+    "an empty file": b"",
+}
+target = os.path.join(tmp, "appended.rec")
+appenders = [
+    ("stream-cat", ["INPUT", "--append", "--output", target]),
+    ("stream-pack", ["obs", "a:i32=1", "--append", "--output", target]),
+    ("keyframe", ["--append", "--output", target, "INPUT"]),
+]
+for program, argv in appenders:
+    for what, old in list(appended_to.items()) + ([("its own input", None)] if "INPUT" in argv else []):
+        with open(os.path.join(tmp, "input.rec"), "wb") as f:
+            f.write(demo if program == "keyframe" else whole)
+        same = old is None
+        path = os.path.join(tmp, "input.rec") if same else target
+        if not same:
+            with open(target, "wb") as f:
+                f.write(old)
+        before = open(path, "rb").read()
+        args = [a.replace("INPUT", os.path.join(tmp, "input.rec")).replace(target, path) for a in argv]
+        label = f"{program} --append onto {what}"
+        try:
+            r = tool(program, *args, timeout=60)
+        except (subprocess.TimeoutExpired, Unbounded):
+            failures.append(f"{label}: no end, or unbounded output")
+            continue
+        after = open(path, "rb").read()
+        err = r.stderr.decode(errors="replace").strip("\n")
+        if r.returncode == 0 and not same:
+            try:
+                records(after)
+                if not after.startswith(before) or len(after) == len(before):
+                    failures.append(f"{label}: exit 0 but the old bytes are not kept, or nothing was added")
+            except read_stream.StreamError as e:
+                failures.append(f"{label}: exit 0 leaving an unreadable file: {e}")
+        elif r.returncode == 1:
+            if len(err.split("\n")) != 1 or path not in err:
+                failures.append(f"{label}: exit 1 but not one line naming {path}: {err[-300:]!r}")
+            if after != before:
+                failures.append(f"{label}: refused, but the file was changed")
+        else:
+            failures.append(f"{label}: exit {r.returncode}: {err[-300:]!r}")
+        ran += 1
 
 print("\n".join(failures[:60]))
 print(f"{ran} mutated inputs of {total} cases (QTE_MUTATIONS={LIMIT} per program), {len(failures)} failures")
