@@ -49,7 +49,7 @@ say "6. the learning loop, short: 5 demos, 60 learner steps on them, 30 explorin
 # full run is 10 demos and 2,000 environment steps). See examples/learn.sh.
 make -s -C examples reach_target RUNS="$(realpath "$out")/runs" BUILD="$(dirname "$(command -v sim-step)")/.." \
   DEMOS=5 PRETRAIN=60 ENV_STEPS=30 EVAL_EVERY=30 CHUNK_EPISODES=5 EVAL_EPISODES=10 CHECKPOINT_EVERY=20 BATCH=16
-run=$out/runs/reach_target/qte-k10-t10-seed0
+run=$out/runs/reach_target/$(make -s -C examples --no-print-directory label)-seed0
 cat "$run/eval.csv" >&2
 stream-cat --type obs --where step=0 --head 1 "$run/demos.rec" \
   | qte-select --checkpoint "$run/ckpt/latest.rec" --k 10 --png "$out/attention" > /dev/null

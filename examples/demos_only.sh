@@ -13,6 +13,7 @@ set -euo pipefail
 task=$1 out=$2
 : "${SEED:=0}" "${DEMOS:=10}" "${IMAGE:=256x256}" "${STEPS:=2000}" "${N_STEP:=3}" "${VARIATION:=0}" "${NET_OPTIONS:=}"
 here=$(cd "$(dirname "$0")" && pwd)
+source "$here/common.sh"
 mkdir -p "$out"
 if [ ! -f "$out/replay.rec" ]; then  # learn.sh's demonstrations for SEED, the same bytes
   demo-record --task "$task" --episodes "$DEMOS" --seed "$SEED" --scenes demo --variation "$VARIATION" --image-size "$IMAGE" \
@@ -26,7 +27,7 @@ qattn-train --resume --steps "$STEPS" --start-after 0 --checkpoint-every 250 --k
 for k in 1 10; do
   csv=$out/failures-step$STEPS-k$k.csv
   [ -f "$csv" ] && continue
-  VARIATION=$VARIATION bash "$here/failure_reasons.sh" "$task" "$out/ckpt/step-$(printf '%08d' "$STEPS").rec" "$k" "$IMAGE" 50 \
+  VARIATION=$VARIATION bash "$here/failure_reasons.sh" "$task" "$(checkpoint_path "$out/ckpt" "$STEPS")" "$k" "$IMAGE" 50 \
     "demonstrations only, $STEPS steps${NET_OPTIONS:+ ($NET_OPTIONS)}, acting K=$k" "$SEED" > "$csv.tmp"
   mv "$csv.tmp" "$csv"
 done

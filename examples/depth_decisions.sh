@@ -11,11 +11,12 @@ set -euo pipefail
 task=$1 checkpoint=$2 k=$3 image=${4:-256x256} episodes=${5:-50} label=${6:-k$3}
 shift $(( $# < 6 ? $# : 6 ))
 here=$(cd "$(dirname "$0")" && pwd)
+source "$here/common.sh"
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 agent=${AGENT:-$tmp/agent.rec}
-mkfifo "$tmp/loop"
-sim-step --task "$task" --variation "${VARIATION:-0}" --episodes "$episodes" --seed "${EVAL_SEED:-1000000}" \
-    --scenes eval --image-size "$image" --objects < "$tmp/loop" \
-  | qte-select --checkpoint "$checkpoint" --k "$k" "$@" --threads 1 \
-  | plan-path | tee "$tmp/loop" > "$agent"
-/usr/bin/python3 "$here/depth_decisions.py" --label "$label" ${DECISION_STEP:+--step "$DECISION_STEP"} "$agent"
+agent_loop "$tmp/loop" \
+  sim-step --task "$task" --variation "${VARIATION:-0}" --episodes "$episodes" --seed "${EVAL_SEED:-1000000}" \
+    --scenes eval --image-size "$image" --objects \
+  qte-select --checkpoint "$checkpoint" --k "$k" "$@" --threads 1 \
+  plan-path > "$agent"
+"$PYTHON" "$here/depth_decisions.py" --label "$label" ${DECISION_STEP:+--step "$DECISION_STEP"} "$agent"

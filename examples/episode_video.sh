@@ -8,14 +8,16 @@
 # PATH=build/tools:$PATH).
 set -euo pipefail
 ckpt=$1 task=$2 out=$3 seed=${4:-0} k=${5:-10} image=${6:-128x128}
+source "$(dirname "$0")/common.sh"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-mkfifo "$tmp/loop"
-sim-step --task "$task" --episodes 1 --seed "$seed" --scenes eval --image-size "$image" < "$tmp/loop" \
-  | tee "$tmp/episode.rec" | qte-select --checkpoint "$ckpt" --k "$k" --png "$tmp/attention" \
-  | plan-path --seed "$seed" | tee "$tmp/planned.rec" > "$tmp/loop"
+# The episode: its observations, actions and planned trajectories.
+agent_loop "$tmp/loop" \
+  sim-step --task "$task" --episodes 1 --seed "$seed" --scenes eval --image-size "$image" \
+  qte-select --checkpoint "$ckpt" --k "$k" --png "$tmp/attention" \
+  plan-path --seed "$seed" > "$tmp/planned.rec"
 stream-cat --type trajectory "$tmp/planned.rec" \
   | sim-step --task "$task" --episodes 1 --seed "$seed" --scenes eval --image-size "$image" --every-step \
   > "$tmp/every_step.rec"
 stream-png --video "$out" --fps 8 --height 256 --attention "$tmp/attention" "$tmp/every_step.rec"
-episode-stats "$tmp/episode.rec" >&2
+episode-stats "$tmp/planned.rec" >&2

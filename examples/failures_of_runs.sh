@@ -6,6 +6,7 @@
 # Usage: failures_of_runs.sh RUNS   (the built programs on PATH; make -C examples failures)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
+source "$here/common.sh"
 for run in "$1"/takeaway*/*/*-seed*/; do
   run=${run%/}
   [ -f "$run/eval.csv" ] && [ -f "$run/eval/checkpoint.rec" ] || continue
@@ -13,10 +14,7 @@ for run in "$1"/takeaway*/*/*-seed*/; do
   label=${name%-seed*} seed=${name##*-seed}
   out=$here/results/$takeaway/failures/${task}_$name.csv
   [ -f "$run/failures.csv" ] || [ -f "$out" ] && continue
-  case $label in
-    adaptive-m*) margin=${label#adaptive-m}; margin=${margin%-max*}; k=(auto --k-margin "$margin" --k-max "${label##*-max}") ;;
-    *) k=${label#*-k}; k=(${k%%-t*}) ;;
-  esac
+  read -r -a k <<< "$(acting_k_of_label "$label")"
   image=$(stream-cat --type obs --head 1 "$run/demos.rec" | stream-dump | awk '$1 ~ /\.rgb$/ { gsub(/[\[\],]/, ""); print $3 "x" $4; exit }')
   episodes=$(awk -F, 'NR == 2 { for (i = 1; i <= NF; i++) if (h[i] == "episodes") print $i } NR == 1 { for (i = 1; i <= NF; i++) h[i] = $i }' "$run/eval.csv")
   echo "$takeaway $task $name: K ${k[*]}, $image, $episodes episodes" >&2

@@ -38,14 +38,18 @@
 # episodes to its own replay file, actors/replay-i.rec, which the learner follows. No FIFO,
 # PID or lock crosses roles; each role is resumable on its own. ROLE=all (the default) is the
 # whole loop in this one process tree, as above. CPU_BUDGET is for ROLE=all only.
+#
+# LABEL names the run in its CSVs; by default run_label (common.sh) of METHOD (qte), ACT_K,
+# TARGET_K, K_MARGIN and K_MAX, as examples/Makefile labels its runs.
 set -euo pipefail
 task=$1 run=$2
+source "$(dirname "$0")/common.sh"
 : "${SEED:=0}" "${DEMOS:=10}" "${VARIATION:=0}" "${IMAGE:=128x128}" "${ACT_K:=10}" "${TARGET_K:=10}"
 : "${ENV_STEPS:=2000}" "${CHUNK_EPISODES:=10}" "${EVAL_EVERY:=250}" "${EVAL_EPISODES:=50}" "${EVAL_SEED:=1000000}"
 : "${ARCH:=light}" "${BATCH:=32}" "${RATIO:=0.5}" "${PRETRAIN:=200}" "${START_AFTER:=0}"
-: "${LEARNER_THREADS:=1}" "${EPSILON:=0.1}" "${ROTATION_NOISE:=1}" "${CHECKPOINT_EVERY:=25}" "${LABEL:=k$ACT_K-$TARGET_K}"
+: "${LEARNER_THREADS:=1}" "${EPSILON:=0.1}" "${ROTATION_NOISE:=1}" "${CHECKPOINT_EVERY:=25}"
 : "${N_STEP:=1}" "${ACTORS:=1}" "${CPU_BUDGET:=0}" "${K_MARGIN:=0.02}" "${K_MAX:=10}" "${ROLE:=all}" "${ACTOR_INDEX:=0}"
-: "${ALSO_ACT_K:=}"
+: "${ALSO_ACT_K:=}" "${METHOD:=qte}" "${LABEL:=$(run_label "$METHOD" "$ACT_K" "$TARGET_K" "$K_MARGIN" "$K_MAX")}"
 mkdir -p "$run/actors" "$run/eval"
 # The script's own waiting costs no process (it is counted in the budget, and a method that
 # takes longer would pay more for it): a read with a timeout on a FIFO nobody writes.
@@ -166,21 +170,21 @@ next_chunk() {  # ACTOR -> its first chunk not finished
 finished_steps() { { cat "$run"/actors/gate-*/[0-9]*.steps 2>/dev/null || true; } | awk '{ n += $1 } END { print n + 0 }'; }
 actor_programs=(sim-step qte-select plan-path tee keyframe)
 start_actor() {  # ACTOR: its pipeline, in the background, from its first chunk not finished
-  local i=$1 gate fifo
-  gate=$(gate_dir "$i") fifo=$run/actors/loop-$i
+  local i=$1 gate
+  gate=$(gate_dir "$i")
   mkdir -p "$gate"
-  rm -f "$fifo" "$run/actors/status-$i"
-  mkfifo "$fifo"
+  rm -f "$run/actors/status-$i"
   (
     set +e  # the status of every program is what this subshell is for
-    sim-step --task "$task" --variation "$VARIATION" --episodes 10000000 --seed $(( SEED * 100000 )) --scenes explore \
+    agent_loop --only-trajectories-back "$run/actors/loop-$i" \
+      sim-step --task "$task" --variation "$VARIATION" --episodes 10000000 --seed $(( SEED * 100000 )) --scenes explore \
         --chunk-episodes "$CHUNK_EPISODES" --first-chunk "$(next_chunk "$i")" --chunk-stride "$ACTORS" --gate "$gate" \
-        --image-size "$IMAGE" --compress < "$fifo" \
-      | qte-select --checkpoint "$run/ckpt/latest.rec" --reload --k "$ACT_K" $act_branching --epsilon "$EPSILON" \
-          --rotation-noise "$ROTATION_NOISE" --seed $(( SEED * 100000 + i )) --threads 1 \
-      | plan-path | tee >(stream-cat --type trajectory > "$fifo") \
-      | keyframe --agent --seed "$SEED" --append --output "$actor_replay"
-    echo "${PIPESTATUS[*]}" > "$run/actors/status-$i"
+        --image-size "$IMAGE" --compress \
+      qte-select --checkpoint "$run/ckpt/latest.rec" --reload --k "$ACT_K" $act_branching --epsilon "$EPSILON" \
+        --rotation-noise "$ROTATION_NOISE" --seed $(( SEED * 100000 + i )) --threads 1 \
+      plan-path \
+      '|' keyframe --agent --seed "$SEED" --append --output "$actor_replay"
+    echo "${agent_loop_status[*]}" > "$run/actors/status-$i"
   ) 2>> "$run/actor.log" &
   actor_pids[$i]=$!
 }
@@ -275,14 +279,7 @@ trap 'kill_tree $(jobs -p)' EXIT  # the learner and the actors, with every progr
 while [ ! -f "$run/ckpt/latest.rec" ]; do check_learner; nap 0.5; done
 
 # The learner's newest step, from its checkpoint names.
-learner_step() {  # (shell builtins only: it runs twice a second)
-  local f n best=-1
-  for f in "$run"/ckpt/step-[0-9]*.rec; do
-    n=${f##*/step-} n=${n%.rec}
-    [[ $n =~ ^[0-9]+$ ]] && (( 10#$n > best )) && best=$(( 10#$n ))
-  done
-  echo "$best"
-}
+learner_step() { newest_checkpoint_step "$run/ckpt"; }
 pretraining=$(( $(learner_step) < PRETRAIN ))  # pretraining happens in this process tree
 # Waits until the learner has taken the steps the replay ratio allows for `agent` transitions.
 # The gradient steps the replay ratio allows after N agent transitions: what
@@ -303,14 +300,15 @@ wait_for_learner() {
 # eval_point: the budget the evaluation stands for (0, EVAL_EVERY, ..., ENV_STEPS); env_steps
 # (what the actor had taken, up to a chunk more) varies between seeds, eval_point does not.
 evaluate() {  # CHECKPOINT ENV_STEPS OUT.csv LEARNER_STEP EVAL_POINT
-  local fifo; fifo=$(mktemp -u); mkfifo "$fifo"
-  sim-step --task "$task" --variation "$VARIATION" --episodes "$EVAL_EPISODES" --seed "$EVAL_SEED" --scenes eval \
-    --image-size "$IMAGE" < "$fifo" \
-    | qte-select --checkpoint "$1" --k "$ACT_K" $act_branching --threads 1 \
-    | plan-path | tee "$fifo" \
-    | episode-stats --label "$LABEL" --column seed="$SEED" --column env_steps="$2" --column train_step="$4" \
-        --column eval_point="$5" --column train_s="$(cat "$run/train_seconds")" $(cpu_columns) \
-        > "$3.tmp"
+  local fifo; fifo=$(mktemp -u)
+  agent_loop "$fifo" \
+    sim-step --task "$task" --variation "$VARIATION" --episodes "$EVAL_EPISODES" --seed "$EVAL_SEED" --scenes eval \
+      --image-size "$IMAGE" \
+    qte-select --checkpoint "$1" --k "$ACT_K" $act_branching --threads 1 \
+    plan-path \
+    '|' episode-stats --label "$LABEL" --column seed="$SEED" --column env_steps="$2" --column train_step="$4" \
+      --column eval_point="$5" --column train_s="$(cat "$run/train_seconds")" $(cpu_columns) \
+    > "$3.tmp"
   rm -f "$fifo"
   mv "$3.tmp" "$3"
 }
@@ -330,7 +328,7 @@ while :; do
   if [ ! -f "$eval_csv" ]; then
     [ "$finished" = 2 ] || wait_for_learner "$env_steps"
     snapshot=$run/eval/checkpoint.rec
-    until step=$(learner_step) && cp "$run/ckpt/step-$(printf '%08d' "$step").rec" "$snapshot" 2>/dev/null; do nap 0.2; done
+    until step=$(learner_step) && cp "$(checkpoint_path "$run/ckpt" "$step")" "$snapshot" 2>/dev/null; do nap 0.2; done
     count_training_time
     # eval_point: the budget the evaluation stands for; out of budget, the steps it bought.
     point=$(( finished == 2 ? env_steps : finished ? ENV_STEPS : mark * EVAL_EVERY ))

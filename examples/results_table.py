@@ -8,6 +8,7 @@
     results_table.py --lookalikes FAILURES.csv...
     results_table.py --paired BASELINE [--markdown] RUN.csv...
     results_table.py --acting FAILURES.csv...
+    results_table.py --reasons FAILURES.csv...
 
 One row per task and label (method): the runs' final evaluations (the last eval_point of each run):
 the environment and learner steps they had taken (means), their success's mean and sample
@@ -30,6 +31,9 @@ and the two-sided p-value of the exact sign-flip permutation test (all 2^n sign 
 the n differences; the test makes no assumption about their distribution). --acting sums
 failure_reasons CSVs per task, label (how the networks were trained) and the K they acted with:
 from the name's _act-kK suffix (learn.sh's ALSO_ACT_K), else the label's own (LABEL = ...-kK-...).
+--reasons sums the episodes' reasons (why each failed: failure_reasons.py's columns) the same
+way, leaving out CSVs written before the reasons. --failures keeps every file's columns (an
+older file's reason columns are empty).
 Standard library only.
 """
 import argparse
@@ -43,6 +47,13 @@ import sys
 from collections import defaultdict
 
 
+def label_settings(label):
+    """(METHOD, ACT_K, TARGET_K) of a run's label as examples/common.sh's run_label writes it,
+    METHOD-kACT_K-tTARGET_K; None for other labels (adaptive K's, an analysis's own)."""
+    m = re.fullmatch(r"(.+)-k(\d+)-t(\d+)", label)
+    return (m.group(1), int(m.group(2)), int(m.group(3))) if m else None
+
+
 def task_of(path, row):
     """TASK of TASK_LABEL-seedN.csv (examples/Makefile's results), else ''."""
     suffix = f"_{row['label']}-seed{row['seed']}.csv"
@@ -51,15 +62,45 @@ def task_of(path, row):
 
 
 def failures(paths):
-    """Every run's failure_reasons rows under one header, each with its run's task."""
-    writer = None
+    """Every run's failure_reasons rows under one header, each with its run's task: the columns
+    of all of them in the order first seen (older files, without the reason columns, leave them
+    empty)."""
+    rows, columns = [], ["task"]
     for path in paths:
         with open(path, newline="") as f:
             for row in csv.DictReader(f):
-                if writer is None:
-                    writer = csv.DictWriter(sys.stdout, fieldnames=["task", *row], lineterminator="\n")
-                    writer.writeheader()
-                writer.writerow({"task": task_of(path, row), **row})
+                columns += [c for c in row if c not in columns]
+                rows.append({"task": task_of(path, row), **row})
+    if rows:
+        writer = csv.DictWriter(sys.stdout, fieldnames=columns, restval="", lineterminator="\n")
+        writer.writeheader()
+        writer.writerows(rows)
+
+
+# failure_reasons.py's reasons, the columns after failed_actions (success has its own column).
+REASONS = ["wrong_object", "grasp_missed", "dropped", "goal_in_collision", "ik_failed", "no_path",
+           "start_in_collision", "outside_workspace", "invalid_pose", "trajectory_refused", "collision",
+           "other_failure", "out_of_steps"]
+
+
+def reasons(paths):
+    """Per task, label and acting K (as --acting), the episodes' reasons summed over runs; the
+    runs whose CSVs predate the reasons are left out."""
+    sums = defaultdict(lambda: defaultdict(int))
+    for path in paths:
+        suffix = re.search(r"_act-k(\d+)\.csv$", path)
+        with open(path, newline="") as f:
+            for row in csv.DictReader(f):
+                if not all(row.get(r) for r in REASONS):
+                    continue
+                own = re.search(r"k(\d+)-t", row["label"])
+                act_k = suffix.group(1) if suffix else own.group(1) if own else ""
+                total = sums[(task_of(re.sub(r"_act-k\d+\.csv$", ".csv", path), row), row["label"], act_k)]
+                total["runs"] += 1
+                for column in ["episodes", "success"] + REASONS:
+                    total[column] += int(row[column])
+    return [{"task": task, "label": label, "acting_k": k, **{c: t[c] for c in ["runs", "episodes", "success"] + REASONS}}
+            for (task, label, k), t in sorted(sums.items(), key=lambda kv: (kv[0][0], kv[0][1], int(kv[0][2] or 0)))]
 
 
 def lookalikes(paths):
@@ -90,8 +131,8 @@ def acting(paths):
         suffix = re.search(r"_act-k(\d+)\.csv$", path)
         with open(path, newline="") as f:
             for row in csv.DictReader(f):
-                own = re.search(r"k(\d+)-t", row["label"])
-                act_k = suffix.group(1) if suffix else own.group(1) if own else ""
+                own = label_settings(row["label"])
+                act_k = suffix.group(1) if suffix else str(own[1]) if own else ""
                 name = re.sub(r"_act-k\d+\.csv$", ".csv", path)
                 total = sums[(task_of(name, row), row["label"], act_k)]
                 total["runs"] += 1
@@ -238,8 +279,13 @@ def main():
     parser.add_argument("--paired", metavar="BASELINE", help="every other label against BASELINE, paired by seed")
     parser.add_argument("--acting", action="store_true",
                         help="failure_reasons CSVs summed per task, label and the K the networks acted with")
+    parser.add_argument("--reasons", action="store_true",
+                        help="failure_reasons CSVs' reasons summed per task, label and acting K")
     parser.add_argument("runs", nargs="+")
     args = parser.parse_args()
+    if args.reasons:
+        print_table(reasons(args.runs), args.markdown)
+        return
     if args.failures:
         failures(args.runs)
         return
@@ -262,8 +308,12 @@ def main():
         rows = [{"series": " ".join(filter(None, key)), **row}
                 for key in sorted(runs) for row in sorted(runs[key], key=lambda r: int(r["seed"]))]
         if args.k_ablation:
-            same_k = [(re.fullmatch(r"qte-k(\d+)-t\1", row["label"]), row) for row in rows]
-            rows = [{"k": m.group(1), **{c: v for c, v in row.items() if c != "series"}} for m, row in same_k if m]
+            same_k = []
+            for row in rows:
+                settings = label_settings(row["label"])
+                if settings and settings[0] == "qte" and settings[1] == settings[2]:
+                    same_k.append({"k": str(settings[1]), **{c: v for c, v in row.items() if c != "series"}})
+            rows = same_k
             rows.sort(key=lambda r: (int(r["k"]), int(r["seed"])))
             if not rows:
                 return

@@ -34,7 +34,7 @@ run() {  # NAME ARGS...
   qte-select --checkpoint "$checkpoint" --threads 1 "$@" "$tmp/obs.rec" > "$tmp/$name.rec" 2>/dev/null
   end=$(date +%s.%N)
   stream-dump --json --type action "$tmp/$name.rec" \
-    | /usr/bin/python3 -c '
+    | "${PYTHON:-/usr/bin/python3}" -c '
 import json, sys
 branches, pose = [], []
 for line in sys.stdin:

@@ -10,7 +10,7 @@ source_dir=$(sed -n 's/^CMAKE_HOME_DIRECTORY:INTERNAL=//p' "$here/../../CMakeCac
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 for _ in 1 2 3; do
   "$here/bench_nets" --light --threads "$threads" | awk '{ print $(NF - 5) >> "'"$tmp"'/ours0"; print $(NF - 1) >> "'"$tmp"'/ours1" }'
-  /usr/bin/python3 "$source_dir/tests/bench/torch_light_ref.py" "$threads" \
+  "${PYTHON:-/usr/bin/python3}" "$source_dir/tests/bench/torch_light_ref.py" "$threads" \
     | awk '{ print $(NF - 5) >> "'"$tmp"'/torch0"; print $(NF - 1) >> "'"$tmp"'/torch1" }'
 done
 median() { sort -g "$tmp/$1" | sed -n 2p; }

@@ -6,7 +6,6 @@
 # voxel is not depth 0's argmax, and with K = 1 overrules nothing; a stream without objects is
 # refused, naming the option.
 source "$(dirname "$0")/common.sh"
-py=/usr/bin/python3
 src=${QTE_SOURCE:?set QTE_SOURCE to the repository}
 export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-PASSIVE}
 export PYTHONPATH="$src/lib/python"

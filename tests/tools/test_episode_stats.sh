@@ -2,7 +2,6 @@
 # episode-stats: episodes of real sim-step runs and of packed observations, the Wilson interval
 # against an independent computation, extra columns, unfinished episodes, damaged input.
 source "$(dirname "$0")/common.sh"
-py=/usr/bin/python3
 
 # Real episodes: three actions whose trajectories do not start at the arm's joints, so each
 # episode ends after one step with a failure (reward 0), and sim-step starts the next.

@@ -2,7 +2,6 @@
 # plot-curves: a PNG of the asked size, one colour per group, same input -> same bytes, errors
 # that name the file, line and column, and no picture left behind by a failure.
 source "$(dirname "$0")/common.sh"
-py=/usr/bin/python3
 
 # Two methods, three seeds, five evaluation steps, as episode-stats --label --column rows.
 {

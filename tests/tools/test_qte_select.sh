@@ -3,7 +3,6 @@
 # everything else passed through; actions consistent with the coarse-to-fine geometry;
 # determinism, exploration, K, --reload, --png, and errors.
 source "$(dirname "$0")/common.sh"
-py=/usr/bin/python3
 src=${QTE_SOURCE:?set QTE_SOURCE to the repository}
 # LibTorch's OpenMP threads spin while they wait for each other: with another busy process on a
 # 2-core machine (tests run in parallel) a forward then takes about a second instead of 20 ms.

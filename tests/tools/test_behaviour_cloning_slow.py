@@ -5,13 +5,15 @@ qattn-train, 300 steps on the demonstrations alone; then on 20 held-out demonstr
 greedy coarse-to-fine choice of qte-select --k 1 on each first observation must land within
 one final-depth voxel of the demonstration's keyframe (its final gripper position: every
 axis within 1.5 voxels of 1.875 cm, i.e. in that voxel or its neighbour) in >= 80% of cases.
-About 4 minutes on 2 cores. Run with a python3 that has NumPy (ctest uses /usr/bin/python3).
+3-7 minutes on 2 cores (300 learner steps), so labelled slow: `make check-slow` runs it, `make
+check` does not. Run with a python3 that has NumPy (ctest uses /usr/bin/python3).
 
 The scenes are fixed (--scenes any, seeds 1 and 99: the ones this test was written on). How
 well 300 steps clone 20 demonstrations depends on the draw: on demo-record's demo scene set
 (seeds 1 and 99) every learner variant measured reached 12-13/20 (published settings, no
-clipping, norm clipping, beta 1), on these 18/20 (docs/learner.md)."""
-import importlib.util
+clipping, norm clipping, beta 1), on these 18/20 (docs/learner.md, docs/testing.md). The
+threshold holds on this draw only; it guards the data path against breaking, not the learner's
+quality in general."""
 import os
 import shutil
 import subprocess

@@ -1,0 +1,76 @@
+# Sourced by the scripts of examples/ (and asked by examples/Makefile for PYTHON and the run
+# label): what they share, written once here — the Python interpreter, a run's label, the
+# learner's checkpoint names and the agent acting in the simulator through a FIFO.
+
+# Debian's Python, with NumPy and matplotlib (debian-packages.txt); PYTHON=... for another.
+: "${PYTHON:=/usr/bin/python3}"
+
+# The label of a run of METHOD (qte, c2farm, adaptive) expanding ACT_K when acting and TARGET_K
+# in the target, or with adaptive K its K_MARGIN and K_MAX: the run's directory and CSV names
+# and eval.csv's label column. qte-k10-t10, c2farm-k1-t0, adaptive-m0.02-max10.
+run_label() {  # METHOD ACT_K TARGET_K K_MARGIN K_MAX
+  if [ "$1" = adaptive ]; then echo "$1-m$4-max$5"; else echo "$1-k$2-t$3"; fi
+}
+# The K a run of LABEL acts with, as qte-select's words: "10", or "auto --k-margin M --k-max N".
+acting_k_of_label() {  # LABEL
+  case $1 in
+    adaptive-m*) local margin=${1#adaptive-m}; echo "auto --k-margin ${margin%-max*} --k-max ${1##*-max}" ;;
+    *) local k=${1#*-k}; echo "${k%%-t*}" ;;
+  esac
+}
+
+# The learner's numbered checkpoints, DIR/step-NNNNNNNN.rec (qattn-train --checkpoint-dir DIR;
+# the program names them in CheckpointDirectory::path_for, lib/learner/training_files.cpp).
+checkpoint_path() {  # DIR STEP
+  printf '%s/step-%08d.rec\n' "$1" "$2"
+}
+newest_checkpoint_step() {  # DIR -> the step of its newest checkpoint, -1 for none
+  local f n best=-1  # shell builtins only: the learning loop asks twice a second
+  for f in "$1"/step-[0-9]*.rec; do
+    n=${f##*/step-} n=${n%.rec}
+    [[ $n =~ ^[0-9]+$ ]] && (( 10#$n > best )) && best=$(( 10#$n ))
+  done
+  echo "$best"
+}
+
+# The agent acting in the simulator, a pipeline closed by a FIFO:
+#   agent_loop [--only-trajectories-back] FIFO sim-step ARG... qte-select ARG... plan-path ARG... ['|' CONSUMER...]
+# runs
+#   sim-step ARG... < FIFO | qte-select ARG... | plan-path ARG... | tee FIFO [| CONSUMER...]
+# sim-step's observations go to qte-select (the next-best pose) and plan-path (its trajectory);
+# plan-path's stream (observations, actions, trajectories) goes back to sim-step through FIFO
+# (made here, an old one removed) and on to CONSUMER, or to standard output without one. With
+# --only-trajectories-back only the trajectories go back (stream-cat --type trajectory), so a
+# sim-step waiting at its --gate holds nothing in flight. The programs' names separate their
+# arguments. The exit statuses of the pipeline's programs, in order, are left in the array
+# agent_loop_status (for a caller without set -e).
+agent_loop() {
+  local back=(tee) fifo stage=sim-step sim=() select=() plan=()
+  if [ "$1" = --only-trajectories-back ]; then back=(send_trajectories_back); shift; fi
+  fifo=$1
+  [ "${2-}" = sim-step ] || { echo "agent_loop: expected sim-step after the FIFO, not '${2-}'" >&2; return 2; }
+  shift 2
+  while [ $# -gt 0 ] && [ "$1" != '|' ]; do
+    case $stage:$1 in
+      sim-step:qte-select) stage=qte-select ;;
+      qte-select:plan-path) stage=plan-path ;;
+      sim-step:*) sim+=("$1") ;;
+      qte-select:*) select+=("$1") ;;
+      plan-path:*) plan+=("$1") ;;
+    esac
+    shift
+  done
+  [ "$stage" = plan-path ] || { echo "agent_loop: expected qte-select then plan-path among its arguments" >&2; return 2; }
+  [ $# -eq 0 ] || shift  # the '|': what follows is the consumer
+  rm -f "$fifo"
+  mkfifo "$fifo"
+  if [ $# -gt 0 ]; then
+    sim-step "${sim[@]}" < "$fifo" | qte-select "${select[@]}" | plan-path "${plan[@]}" | "${back[@]}" "$fifo" | "$@"
+  else
+    sim-step "${sim[@]}" < "$fifo" | qte-select "${select[@]}" | plan-path "${plan[@]}" | "${back[@]}" "$fifo"
+  fi
+  agent_loop_status=("${PIPESTATUS[@]}")
+}
+send_trajectories_back() {  # FIFO: standard input to standard output, its trajectories also to FIFO
+  tee >(stream-cat --type trajectory > "$1")
+}
