@@ -1,9 +1,16 @@
 #!/usr/bin/env bash
-# Where a checkpoint's greedy agent goes on the held-out evaluation scenes, against the expert
-# on the same scenes (failure_reasons.py): successes, distractors, the target missed, elsewhere.
+# Where a checkpoint's greedy agent goes on the held-out evaluation scenes and why each episode
+# fails, against the expert on the same scenes (failure_reasons.py): successes, distractors,
+# the target missed, elsewhere; and a reason per episode (wrong object, grasp missed, dropped,
+# the planner's or the simulator's refusal, out of steps), counted per reason.
 # Usage: failure_reasons.sh TASK CHECKPOINT K [IMAGE] [EPISODES] [LABEL] [SEED] [QTE-SELECT OPTIONS...]
 #        (the built programs on PATH). The scenes are learn.sh's evaluation scenes: VARIATION
 #        (0) and EVAL_SEED (1000000) as there. FAILURE_EPISODES=1: a line per episode on stderr.
+# The expert's episodes of the scenes are recorded once per task, VARIATION, EVAL_SEED,
+# EPISODES, IMAGE and demo-record program (its checksum: a rebuilt expert records again) and
+# kept in EXPERT_CACHE, by default expert-cache/ beside the run directory (the checkpoint's
+# directory's parent: RUNS/<takeaway>/<task>/expert-cache for learn.sh's runs, shared by
+# every method and seed of the task); EXPERT_CACHE= (empty) keeps nothing.
 set -euo pipefail
 task=$1 checkpoint=$2 k=$3 image=${4:-256x256} episodes=${5:-50} label=${6:-k$3} seed=${7:-}
 shift $(( $# < 7 ? $# : 7 ))
@@ -12,10 +19,20 @@ source "$here/common.sh"
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 scenes=(--task "$task" --variation "${VARIATION:-0}" --episodes "$episodes" --seed "${EVAL_SEED:-1000000}" --scenes eval
         --image-size "$image")
-demo-record "${scenes[@]}" --compress --output "$tmp/experts.rec" 2>/dev/null
+cache=${EXPERT_CACHE-$(dirname "$(dirname "$checkpoint")")/../expert-cache}
+if [ -n "$cache" ]; then
+  build=$(sha256sum "$(command -v demo-record)" | cut -c1-12)
+  experts=$cache/${task}_variation${VARIATION:-0}_seed${EVAL_SEED:-1000000}_episodes${episodes}_${image}_demo-record-$build.rec
+else
+  experts=$tmp/experts.rec
+fi
+if [ ! -f "$experts" ]; then  # demo-record writes its --output whole or not at all (renamed into place)
+  mkdir -p "$(dirname "$experts")"
+  demo-record "${scenes[@]}" --objects --no-points --compress --output "$experts" 2>/dev/null
+fi
 agent_loop "$tmp/loop" \
   sim-step "${scenes[@]}" --objects \
   qte-select --checkpoint "$checkpoint" --k "$k" "$@" --threads 1 \
   plan-path > "$tmp/agent.rec"
 "$PYTHON" "$here/failure_reasons.py" --label "$label" --seed "$seed" ${FAILURE_EPISODES:+--episodes} \
-  "$tmp/experts.rec" "$tmp/agent.rec"
+  "$experts" "$tmp/agent.rec"

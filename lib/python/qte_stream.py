@@ -39,7 +39,8 @@ Record = collections.namedtuple("Record", "type fields offset index")
 # A task object of an observation written with `sim-step --objects` (or `demo-record
 # --objects`): its id (the row), name, role ("target", "distractor" or "other"), pose (x, y, z,
 # qx, qy, qz, qw, world frame) and bounding box in its own frame (lower and upper corner).
-SceneObject = collections.namedtuple("SceneObject", "id name role pose box_min box_max")
+# held: True when the gripper holds it (objects.held), None in streams written before that field.
+SceneObject = collections.namedtuple("SceneObject", "id name role pose box_min box_max held", defaults=(None,))
 ROLES = {0: "other", 1: "target", 2: "distractor"}
 
 
@@ -198,7 +199,8 @@ def _unzstd(data, raw_bytes, max_field_bytes, bad):
 
 def scene_objects(record):
     """The task objects an observation carries (objects.*), as SceneObjects in id order; None
-    when it carries none (a stream written without --objects)."""
+    when it carries none (a stream written without --objects). `held` is None in streams
+    written before objects.held."""
     f = record.fields
     if "objects.pose" not in f:
         return None
@@ -207,7 +209,12 @@ def scene_objects(record):
     if not (len(names) == len(role) == len(pose) == len(box)):
         raise StreamError(f"record {record.index} at byte {record.offset}: objects.names, objects.role, "
                           f"objects.pose and objects.box disagree on the number of objects")
-    return [SceneObject(i, names[i], ROLES.get(int(role[i]), "other"), pose[i], box[i, :3], box[i, 3:])
+    held = np.asarray(f["objects.held"]).reshape(-1) if "objects.held" in f else None
+    if held is not None and len(held) != len(names):
+        raise StreamError(f"record {record.index} at byte {record.offset}: objects.held and objects.names "
+                          f"disagree on the number of objects")
+    return [SceneObject(i, names[i], ROLES.get(int(role[i]), "other"), pose[i], box[i, :3], box[i, 3:],
+                        None if held is None else bool(held[i]))
             for i in range(len(names))]
 
 

@@ -119,12 +119,13 @@ stream::Record Simulator::observe(const std::string& failure) {
 void set_object_fields(stream::Record& obs, const world::World& world) {
   const int n = world.object_count();
   std::string names;
-  std::vector<uint8_t> roles;
+  std::vector<uint8_t> roles, held;
   std::vector<double> poses, boxes;
   for (int id = 0; id < n; ++id) {
     const world::ObjectSpec& spec = world.object_spec(id);
     names += (id ? "," : "") + spec.name;
     roles.push_back(static_cast<uint8_t>(spec.role));
+    held.push_back(world.held_object() == id);
     const auto pose = robot::pose_values(world.object_pose(id));
     poses.insert(poses.end(), pose.begin(), pose.end());
     const Eigen::AlignedBox3d box = world.object_box(id);
@@ -134,6 +135,7 @@ void set_object_fields(stream::Record& obs, const world::World& world) {
   obs.set<uint8_t>("objects.role", {n}, roles);
   obs.set<double>("objects.pose", {n, robot::kPoseValues}, poses);
   obs.set<double>("objects.box", {n, 6}, boxes);
+  obs.set<uint8_t>("objects.held", {n}, held);
 }
 
 void Simulator::handle(const stream::Record& record, const stream::Emit& emit) {

@@ -36,13 +36,15 @@ struct SimulatorOptions {
   int render_threads = 2;
   bool compress_images = false;       // zstd on rgb/depth/points (for files on disk)
   // Also write the task's objects as the simulator knows them (objects.*: names, roles, poses,
-  // bounding boxes), for analyses of where an agent went; the agent never reads them.
+  // bounding boxes, which one is held), for analyses of where an agent went and why it
+  // failed; the agent never reads them.
   bool object_poses = false;
 };
 
 // The objects.* fields of an observation: every object of `world` in id order, its name
-// (objects.names, joined by commas), role (ObjectSpec::Role's code), pose and bounding box
-// in its own frame (lower then upper corner).
+// (objects.names, joined by commas), role (ObjectSpec::Role's code), pose, bounding box in
+// its own frame (lower then upper corner) and whether the gripper holds it (objects.held:
+// what tells a grasp that closed on nothing, or a dropped object, from one that holds).
 void set_object_fields(stream::Record& obs, const world::World& world);
 
 // Options for the cameras named in `cameras` ("front,wrist") at resolution `image_size`

@@ -9,8 +9,9 @@ std::vector<cli::OptionSpec> camera_options() {
       {"cameras", "LIST", "comma-separated cameras: front, wrist, overhead", "front"},
       {"image-size", "WxH", "camera resolution, e.g. 128x128 or 256x256", "128x128"},
       {"compress", "", "zstd-compress images and point clouds (for files on disk)", ""},
-      {"objects", "", "also write every task object's name, role (target, distractor, other), pose and bounding box "
-                      "in observations (objects.*: for analyses of where an agent went; agents never read them)", ""},
+      {"objects", "", "also write every task object's name, role (target, distractor, other), pose, bounding box "
+                      "and whether the gripper holds it in observations (objects.*: for analyses of where an agent "
+                      "went and why it failed; agents never read them)", ""},
   };
 }
 

@@ -3,7 +3,10 @@
 here by hand (three objects of points on the table, the expert over the first) against the rule
 it documents: success; a distractor (the object it went for is not the expert's); the target
 missed; elsewhere (over 4 cm from every object); the first closing pose decides a grasp; and a
-table without objects. Run with Debian's python3 (NumPy)."""
+table without objects. Then each reason from observations written before objects.held (what
+the fingers stopped on): the first cause, one made good by a later grasp, a lookalike before
+all, every failure name mapped. (tests/tools/test_failure_reasons_run.sh: the reasons on a real
+scene.) Run with Debian's python3 (NumPy)."""
 import os
 import sys
 
@@ -66,6 +69,66 @@ kind, _, _ = fr.classify([obs(0, with_objects=False)], {"obs": [obs(0, with_obje
                                                         "actions": [action(OBJECTS[0])]})
 if kind != "success":
     failures.append(f"a table without objects: expected success, got {kind}")
+
+# Reasons from the observations alone, in a stream written before objects.held: the gripper
+# holds something when closed with the fingers stopped apart (over 1 mm).
+def step(gripper_open=1, opening=0.085, failure="", success=0):
+    fields = {"gripper_open": np.array(gripper_open, np.uint8), "gripper_opening_m": np.array(opening),
+              "gripper_pose": np.array([0.3, 0.3, TABLE + 0.05, 1, 0, 0, 0]), "step": np.array(0, np.int32),
+              "success": np.array(success, np.uint8)}
+    if failure:
+        fields["failure"] = failure
+    return Record("obs", fields, 0, 0)
+
+
+held, missed, opened = step(0, 0.07), step(0, 0.0), step(1)
+reason_cases = [
+    ("success", [step(), held, step(0, 0.07, success=1)], "target"),
+    ("grasp_missed", [step(), missed, step(0, 0.0)], "elsewhere"),
+    ("dropped", [step(), held, opened], "target"),
+    ("no_path", [step(), held, opened, held, step(0, 0.07, failure="timeout")], "target"),  # made good by the grasp again
+    ("grasp_missed", [step(), missed, opened, step(failure="goal_in_collision")], "elsewhere"),  # the first cause
+    ("wrong_object", [step(), held, opened], "distractor"),  # went for a lookalike: whatever came after
+    ("ik_failed", [step(), step(failure="ik_failed")], "elsewhere"),
+    ("trajectory_refused", [step(), step(failure="joint_limits:joint2")], "elsewhere"),
+    ("trajectory_refused", [step(), step(failure="invalid_trajectory:not_finite")], "elsewhere"),
+    ("collision", [step(), step(failure="collision:link3-table")], "elsewhere"),
+    ("other_failure", [step(), step(failure="something_new")], "elsewhere"),
+    ("out_of_steps", [step(), step(), step()], "elsewhere"),
+]
+for want, observations, kind in reason_cases:
+    got = fr.reason({"obs": observations, "actions": []}, kind)
+    if got != want:
+        failures.append(f"reason: expected {want}, got {got} ({kind}, {len(observations)} observations)")
+if fr.reason({"obs": [step(), missed], "actions": []}, "elsewhere", grasping=False) != "out_of_steps":
+    failures.append("a gripper closed on nothing in a task that needs no grasp counts as grasp_missed")
+if set(fr.REASONS) != {want for want, _, _ in reason_cases} | {"goal_in_collision", "no_path", "start_in_collision",
+                                                               "outside_workspace", "invalid_pose"}:
+    failures.append(f"REASONS {fr.REASONS} and the cases tested differ")
+for failure in ("goal_in_collision", "ik_failed", "no_path", "start_in_collision", "outside_workspace", "invalid_pose"):
+    if fr.action_reason(failure) != failure:  # plan-path's own names
+        failures.append(f"plan-path's {failure}: {fr.action_reason(failure)}")
+
+# What is held: objects.held where the observation has it, else the object the closed gripper
+# is on (scene_objects' held is None then).
+def with_objects(at, held=None):
+    o = step(0, 0.05)
+    o.fields.update({"objects.names": "block,lookalike", "objects.role": np.array([1, 2], np.uint8),
+                     "objects.pose": np.array([[0.3, 0.3, TABLE + 0.025, 0, 0, 0, 1], [0.1, 0.1, TABLE + 0.025, 0, 0, 0, 1]]),
+                     "objects.box": np.array([[-0.025] * 3 + [0.025] * 3] * 2)})
+    o.fields["gripper_pose"] = np.array([at[0], at[1], TABLE + 0.03, 1, 0, 0, 0])
+    if held is not None:
+        o.fields["objects.held"] = np.array(held, np.uint8)
+    return o
+
+
+for want, o in [("target", with_objects((0.3, 0.3))), ("distractor", with_objects((0.1, 0.1))),
+                ("distractor", with_objects((0.3, 0.3), [0, 1])), (None, with_objects((0.3, 0.3), [0, 0]))]:
+    if fr.held_role(o) != want:
+        failures.append(f"held_role: expected {want}, got {fr.held_role(o)}")
+if [o.held for o in fr.scene_objects(with_objects((0.3, 0.3)))] != [None, None]:
+    failures.append("scene_objects without objects.held: held is not None")
+
 if failures:
     sys.exit("FAIL: " + "; ".join(failures))
-print(f"failure reasons ok: {len(cases) + 1} episodes sorted as the rule says")
+print(f"failure reasons ok: {len(cases) + 1} episodes sorted as the rule says, {len(reason_cases) + 1} reasons")

@@ -110,6 +110,30 @@ def main():
         assert [(r["task"], r["label"], r["success"]) for r in joined] == [
             ("failures_reach_prism", "qte-k2-t2", "21"), ("failures_lift_numbered_block", "c2farm-k1-t0", "20")], joined
 
+        # With the reasons (failure_reasons.py's columns after failed_actions): an older file
+        # first keeps the newer file's columns, empty for it; --reasons sums them per task,
+        # label and acting K, leaving the older file out.
+        reason_columns = ["wrong_object", "grasp_missed", "dropped", "goal_in_collision", "ik_failed", "no_path",
+                          "start_in_collision", "outside_workspace", "invalid_pose", "trajectory_refused",
+                          "collision", "other_failure", "out_of_steps"]
+        with_reasons = []
+        for name, seed, counts in [("pick_up_cup_c2farm-k1-t0-seed0.csv", 0, [2, 20, 3, 10, 0, 1, 0, 0, 0, 2, 0, 0, 2]),
+                                   ("pick_up_cup_c2farm-k1-t0-seed1_act-k10.csv", 1, [1, 9, 0, 30, 0, 0, 0, 0, 0, 0, 0, 0, 0]),
+                                   ("pick_up_cup_c2farm-k1-t0-seed1.csv", 1, [0, 10, 1, 25, 0, 0, 0, 0, 0, 0, 0, 0, 4])]:
+            path = os.path.join(d, "reasons_" + name)
+            with open(path, "w") as f:
+                f.write("label,seed,episodes,success,distractor,target,elsewhere,failed_actions," + ",".join(reason_columns) + "\n")
+                f.write(f"c2farm-k1-t0,{seed},50,{50 - sum(counts)},0,0,0,0," + ",".join(map(str, counts)) + "\n")
+            with_reasons.append(path)
+        joined = rows_of(run("--failures", failed[0], with_reasons[0]).stdout)
+        assert [(r["label"], r["grasp_missed"], r["out_of_steps"]) for r in joined] == [
+            ("qte-k2-t2", "", ""), ("c2farm-k1-t0", "20", "2")], joined
+        summed = rows_of(run("--reasons", failed[0], *with_reasons).stdout)
+        assert [(r["task"], r["acting_k"], r["runs"], r["episodes"], r["success"], r["grasp_missed"], r["goal_in_collision"],
+                 r["out_of_steps"]) for r in summed] == [
+            ("reasons_pick_up_cup", "1", "2", "100", str(100 - 40 - 40), "30", "35", "6"),
+            ("reasons_pick_up_cup", "10", "1", "50", "10", "9", "30", "0")], summed
+
         # Summed per task and label: of the tries at an object (success, target, distractor),
         # the share at the right one (success, target).
         tried = []

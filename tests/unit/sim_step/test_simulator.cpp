@@ -247,6 +247,54 @@ TEST(Simulator, GraspHoldsThroughLiftingAndOpeningReleases) {
   EXPECT_NEAR(world.object_pose(block).translation().z(), z0, 0.005);  // fell back to the table
 }
 
+// objects.held says which object the gripper holds: the cup after the expert's grasp, none
+// after opening on it, none after closing on empty space, and no such field without --objects.
+TEST(Simulator, ObjectsHeldSaysWhatTheGripperHolds) {
+  SimulatorOptions options = small_options();
+  options.object_poses = true;
+  Simulator simulator(xarm(), options);
+  std::vector<stream::Record> out;
+  auto send = [&](const stream::Record& r) { simulator.handle(r, [&](const stream::Record& obs) { out.push_back(obs); }); };
+  auto held = [&] {
+    const auto h = out.back().array<uint8_t>("objects.held");
+    EXPECT_EQ(h.shape, (stream::Shape{2}));  // the cup, the other cup
+    return std::vector<uint8_t>(h.begin(), h.end());
+  };
+  auto move = [&](const Eigen::Isometry3d& pose, bool gripper_open) {
+    world::World& world = *simulator.world();
+    send(test_support::straight_trajectory(xarm(), world.joint_positions(), test_support::ik_world(world, pose),
+                                           gripper_open));
+  };
+  send(reset_record("pick_up_cup", 0, 5));
+  EXPECT_EQ(out.back().string("objects.names"), "cup,other_cup");
+  EXPECT_EQ(held(), (std::vector<uint8_t>{0, 0}));
+  const auto waypoints = simulator.task()->expert_waypoints(*simulator.world());
+  move(waypoints[0].tcp_pose, true);   // above the cup
+  move(waypoints[1].tcp_pose, false);  // grasp it
+  EXPECT_EQ(held(), (std::vector<uint8_t>{1, 0}));
+  move(waypoints[1].tcp_pose, true);   // open there: let go of it
+  EXPECT_EQ(held(), (std::vector<uint8_t>{0, 0}));
+  EXPECT_EQ(out.back().scalar<uint8_t>("success"), 0);
+
+  send(reset_record("pick_up_cup", 0, 5));
+  Eigen::Isometry3d empty = waypoints[1].tcp_pose;  // 12 cm beside the cup, the other cup 15 cm or more away
+  const Eigen::Vector3d other = simulator.world()->object_pose(1).translation();
+  const Eigen::Vector3d away = (empty.translation() - other).normalized();
+  empty.translation() += 0.12 * Eigen::Vector3d(away.x(), away.y(), 0).normalized();
+  Eigen::Isometry3d above = empty;
+  above.translation().z() += 0.1;
+  move(above, true);
+  move(empty, false);
+  EXPECT_FALSE(out.back().has("failure"));
+  EXPECT_EQ(out.back().scalar<uint8_t>("gripper_open"), 0);
+  EXPECT_EQ(held(), (std::vector<uint8_t>{0, 0}));
+  EXPECT_LT(out.back().scalar<double>("gripper_opening_m"), 1e-6);  // closed on nothing
+
+  SimRun plain;
+  plain.send(reset_record("pick_up_cup", 0, 5));
+  EXPECT_FALSE(plain.last().has("objects.held"));
+}
+
 TEST(Simulator, ObjectsArePushedByTheArm) {
   SimRun run;
   run.send(reset_record("pick_and_lift", 0, 3));
