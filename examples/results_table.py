@@ -93,8 +93,8 @@ def reasons(paths):
             for row in csv.DictReader(f):
                 if not all(row.get(r) for r in REASONS):
                     continue
-                own = re.search(r"k(\d+)-t", row["label"])
-                act_k = suffix.group(1) if suffix else own.group(1) if own else ""
+                own = label_settings(row["label"])
+                act_k = suffix.group(1) if suffix else str(own[1]) if own else ""
                 total = sums[(task_of(re.sub(r"_act-k\d+\.csv$", ".csv", path), row), row["label"], act_k)]
                 total["runs"] += 1
                 for column in ["episodes", "success"] + REASONS:
