@@ -57,9 +57,10 @@ sanitize: deps
 	  ctest --test-dir $(BUILD)-asan --output-on-failure -j $(JOBS) -LE 'slow|slurm'
 
 # libFuzzer for FUZZ_SECONDS of CPU time per target (clang from debian-packages.txt): the stream
-# decoder, then each record type's readers (tests/fuzz/fuzz_<target>.cpp, seeds in
-# tests/fuzz/corpus/<target>/). A finding is written to tests/fuzz/findings/ and fails the target.
-FUZZ_TARGETS ?= stream_reader obs action trajectory transition checkpoint
+# decoder, each record type's readers, then the camera files' readers (.pcd; PNG and joint CSV)
+# (tests/fuzz/fuzz_<target>.cpp, seeds in tests/fuzz/corpus/<target>/). A finding is written to
+# tests/fuzz/findings/ and fails the target.
+FUZZ_TARGETS ?= stream_reader obs action trajectory transition checkpoint pcd camera_recordings
 fuzz: deps
 	cmake -S . -B $(BUILD)-fuzz -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
 	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DQTE_FUZZ=ON -DQTE_TESTS=ON $(CMAKE_FLAGS)

@@ -1,5 +1,4 @@
 // obs-pack: saved RGB-D camera frames (colour + 16-bit depth PNGs, or .pcd clouds) to 'obs' records.
-#include <opencv2/imgcodecs.hpp>
 #include <sys/stat.h>
 
 #include <cctype>
@@ -7,6 +6,7 @@
 #include <iostream>
 
 #include "camera_recordings/camera_recordings.hpp"
+#include "camera_recordings/png_frames.hpp"
 #include "cli/command.hpp"
 #include "point_clouds/pcd_file.hpp"
 #include "stream/writer.hpp"
@@ -38,6 +38,13 @@ static cli::Usage usage() {
       "m); the gripper pose follows by forward kinematics. Without it the records carry no joint "
       "state and plan-path refuses them; qte-select needs only the gripper opening (open). "
       "Records are written whole or not at all; a bad file stops with one line naming it.",
+      "Files are checked before they are decoded. PNGs: at most 32768 pixels on a side and 50 "
+      "million in all; the colour PNG of any colour type (reduced to 8-bit RGB), the depth PNG "
+      "16-bit greyscale. .pcd files (DATA ascii, binary or binary_compressed): x, y, z 4-byte "
+      "floats (TYPE F SIZE 4 COUNT 1), rgb or rgba 4 packed bytes (TYPE F or U), WIDTH x HEIGHT "
+      "equal to POINTS (at most 50 million), and the file as long as the header says: ASCII "
+      "data exactly POINTS lines of one number per value, each of its field's type. The joint "
+      "CSV: every cell a finite number (a row of nan is refused, not taken for a header).",
   };
   u.options = {
       {"rgb", "PATTERN", "colour PNGs, e.g. frames/color_%06d.png", ""},
@@ -158,10 +165,8 @@ static void run(const cli::Arguments& args) {
     stream::Record obs("obs");
     if (images) {
       const std::string depth_path = frame_path(args.text("depth"), index);
-      const cv::Mat bgr = cv::imread(first, cv::IMREAD_COLOR);
-      const cv::Mat depth = cv::imread(depth_path, cv::IMREAD_UNCHANGED);
-      if (bgr.empty()) throw Error(first + ": not a readable image");
-      if (depth.empty()) throw Error(depth_path + ": not a readable image");
+      const cv::Mat bgr = camera_recordings::read_colour_png(first);
+      const cv::Mat depth = camera_recordings::read_depth_png(depth_path);
       camera_recordings::add_camera_images(obs, camera, bgr, depth, first + " and " + depth_path);
     } else {
       camera_recordings::add_camera_cloud(obs, camera, point_clouds::read_pcd(first));

@@ -1,8 +1,8 @@
 #include "camera_recordings/camera_recordings.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
-#include <sstream>
 
 #include "common/error.hpp"
 #include "robot/pose_values.hpp"
@@ -101,31 +101,67 @@ void add_episode_fields(stream::Record& obs, int step, int episode_length, const
   obs.set_scalar<int64_t>("episode_seed", 0);
 }
 
+namespace {
+
+// One CSV cell: a finite number, a number that is not finite (nan, inf, 1e999) or not a number.
+enum class Cell { finite, not_finite, not_a_number };
+
+Cell read_cell(const std::string& text, double& value) {
+  const char* s = text.c_str();
+  char* end = nullptr;
+  value = std::strtod(s, &end);
+  while (end && (*end == ' ' || *end == '\t' || *end == '\r')) ++end;
+  if (end == s || *end != '\0') return Cell::not_a_number;
+  return std::isfinite(value) ? Cell::finite : Cell::not_finite;
+}
+
+// Cells between commas: "a,,b," is four cells, the second and last empty.
+std::vector<std::string> cells_of(const std::string& line) {
+  std::vector<std::string> cells(1);
+  for (char c : line) {
+    if (c == ',') cells.emplace_back();
+    else cells.back() += c;
+  }
+  return cells;
+}
+
+std::string shown(std::string cell) {
+  while (!cell.empty() && (cell.back() == '\r' || cell.back() == ' ')) cell.pop_back();
+  if (cell.empty()) return "empty";
+  if (cell.size() > 32) return "a " + std::to_string(cell.size()) + "-character text";
+  for (char& c : cell)
+    if (c < 0x20 || c > 0x7e) c = '?';
+  return "'" + cell + "'";
+}
+
+}  // namespace
+
 std::vector<RobotState> read_joint_csv(const std::string& path, const robot::RobotModel& robot) {
   std::ifstream in(path);
   if (!in) throw_system_error("cannot open " + path);
   std::vector<RobotState> states;
   const robot::JointVector lo = robot.lower_limits(), hi = robot.upper_limits();
+  const std::string columns = "7 joint angles in radians, then optionally the gripper opening in metres";
   std::string line;
   for (int number = 1; std::getline(in, line); ++number) {
-    if (line.empty() || line[0] == '#') continue;
-    std::vector<double> values;
-    std::stringstream cells(line);
-    bool numeric = true;
-    for (std::string cell; std::getline(cells, cell, ',');) {
-      char* end = nullptr;
-      const double x = std::strtod(cell.c_str(), &end);
-      while (end && (*end == ' ' || *end == '\r')) ++end;
-      if (end == cell.c_str() || *end != '\0' || !std::isfinite(x)) numeric = false;
-      values.push_back(x);
+    if (line.empty() || line == "\r" || line[0] == '#') continue;
+    const std::vector<std::string> cells = cells_of(line);
+    std::vector<double> values(cells.size());
+    std::vector<Cell> kinds(cells.size());
+    bool any_number = false;
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+      kinds[c] = read_cell(cells[c], values[c]);
+      any_number = any_number || kinds[c] != Cell::not_a_number;
     }
+    // A first line of names is a header; "nan" or "inf" reads as a number, so a row of them is data.
+    if (number == 1 && !any_number) continue;
     const std::string where = path + ": line " + std::to_string(number) + ": ";
-    if (!numeric) {
-      if (states.empty() && number == 1) continue;  // a header
-      throw Error(where + "expected numbers (7 joint angles in radians, then optionally the gripper opening in metres)");
-    }
+    for (std::size_t c = 0; c < cells.size(); ++c)
+      if (kinds[c] != Cell::finite)
+        throw Error(where + "column " + std::to_string(c + 1) + " is " + shown(cells[c]) + ", expected a finite number (" +
+                    columns + ")");
     if (values.size() != 7 && values.size() != 8)
-      throw Error(where + "expected 7 or 8 columns, got " + std::to_string(values.size()));
+      throw Error(where + std::to_string(values.size()) + " columns, expected 7 or 8 (" + columns + ")");
     RobotState s;
     for (int k = 0; k < robot::kArmJoints; ++k) {
       s.joints[k] = values[k];
@@ -144,6 +180,8 @@ std::vector<RobotState> read_joint_csv(const std::string& path, const robot::Rob
     }
     states.push_back(s);
   }
+  if (in.bad()) throw_system_error("cannot read " + path);
+  if (states.empty()) throw Error(path + ": no rows, expected one row per frame (" + columns + ")");
   return states;
 }
 

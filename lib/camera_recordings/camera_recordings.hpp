@@ -52,8 +52,10 @@ void add_robot_state(stream::Record& obs, const RobotState& state, const robot::
 void add_episode_fields(stream::Record& obs, int step, int episode_length, const std::string& task);
 
 // A CSV with one row per frame: 7 joint angles in radians, optionally the gripper opening in
-// metres as an 8th column; a first row that is not numbers is a header. Throws Error naming
-// the file, line and what was expected; joints outside the robot's limits are refused.
+// metres as an 8th column; a first row with no number in it is a header (nan and inf are
+// numbers: a row of them is data, and refused). Every cell must be a finite number. Throws
+// Error naming the file, line, column and what was expected; joints outside the robot's
+// limits and a file without rows are refused.
 std::vector<RobotState> read_joint_csv(const std::string& path, const robot::RobotModel& robot);
 
 }  // namespace qte::camera_recordings
