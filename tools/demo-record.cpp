@@ -3,6 +3,7 @@
 
 #include "cli/command.hpp"
 #include "demos/demo_recorder.hpp"
+#include "planning/planner_options.hpp"
 #include "sim_step/simulator_options.hpp"
 #include "stream/writer.hpp"
 #include "tasks/task.hpp"
@@ -27,8 +28,8 @@ static cli::Usage usage() {
       {"task", "T", "one of: " + tasks::task_list(), "", false, true},
       {"retries", "N", "new seeds to try for an episode whose expert failed", "0"},
       {"no-points", "", "leave point clouds out of the recorded observations (the planner still uses them)", ""},
-      {"time-budget", "S", "planner time budget per move, seconds", "2"},
   };
+  u.options.push_back(planning::time_budget_option());
   u.options.push_back(cli::output_file());
   u.add_options(sim_step::episode_options(10, sim_step::SceneSet::demo));
   u.add_options(sim_step::camera_options());
@@ -47,8 +48,7 @@ static void run(const cli::Arguments& args) {
   demos::DemoOptions options;
   options.episodes = sim_step::parse_episode_plan(args, args.text("task"));
   options.retries = static_cast<int>(args.integer("retries", 0, 1000));
-  options.planner.time_budget_s = args.real("time-budget", 0.001, 600);
-  options.planner.seed = args.seed();
+  options.planner = planning::planner_options_from(args);
   options.simulator = sim_step::parse_camera_options(args);
   options.simulator.point_clouds = true;  // the planner needs them; dropped on output with --no-points
 

@@ -67,12 +67,9 @@ static void run(const cli::Arguments& args) {
     extra_names += "label,";
     extra_values += report::csv_cell(args.text("label")) + ",";
   }
-  for (const std::string& column : args.all("column")) {
-    const auto equals = column.find('=');
-    if (equals == std::string::npos || equals == 0)
-      throw UsageError("--column: expected NAME=VALUE, got '" + column + "'");
-    extra_names += report::csv_cell(column.substr(0, equals)) + ",";
-    extra_values += report::csv_cell(column.substr(equals + 1)) + ",";
+  for (const auto& [name, value] : args.assignments("column")) {
+    extra_names += report::csv_cell(name) + ",";
+    extra_values += report::csv_cell(value) + ",";
   }
 
   const std::vector<std::string> files = args.inputs();

@@ -4,6 +4,7 @@
 #include "cli/command.hpp"
 #include "keyframes/transitions.hpp"
 #include "stream/reader.hpp"
+#include "stream/stream_options.hpp"
 #include "stream/writer.hpp"
 #include "voxels/hierarchy_options.hpp"
 
@@ -21,7 +22,7 @@ static cli::Usage usage() {
       "stopped (every joint velocity within +-0.1 rad/s, the gripper unchanged around it, no "
       "stop in the 4 frames before, not the second-to-last frame); of two adjacent final "
       "keyframes the first is dropped.",
-      "Besides the chain from the first frame, a chain starts at every --every-th frame (demo "
+      "Besides the chain from the first frame, a chain starts at every --augment-every-th frame (demo "
       "augmentation), each leading through the keyframes after it. A transition's action is its "
       "next keyframe's gripper pose: the voxel index at every depth (depth d inside the grid "
       "centred on depth d-1's voxel, shifted by U(-0.75, 0.75) * offset per axis with crop "
@@ -42,14 +43,14 @@ static cli::Usage usage() {
   };
   u.arguments = {cli::input_file("demonstrations")};
   u.options = {
-      {"every", "N", "start a demo-augmentation chain at every N-th frame; 0 for none", "10"},
+      {"augment-every", "N", "start a demo-augmentation chain at every N-th frame; 0 for none",
+       cli::default_text(keyframes::TransitionOptions{}.augmentation_every_n)},
       {"no-crop-augmentation", "", "use the unshifted centres for the deeper grids", ""},
       {"keep-failed", "", "also convert unsuccessful episodes (reward 0 throughout)", ""},
       {"not-demo", "", "mark the transitions as the agent's own, not demonstrations", ""},
-      {"append", "", "append to --output (a growing replay file)", ""},
-      {"repair", "", "with --append: cut a torn last record (left by a killed writer) off --output instead of refusing to append behind it", ""},
       {"agent", "", "convert the agent's episodes (obs and action records) instead of demonstrations", ""},
   };
+  u.add_options(stream::append_options());
   u.options.push_back(cli::output_file());
   u.add_options(voxels::hierarchy_options());
   u.uses_randomness = true;
@@ -65,17 +66,14 @@ static cli::Usage usage() {
 
 static void run(const cli::Arguments& args) {
   keyframes::TransitionOptions options;
-  options.augmentation_every_n = static_cast<int>(args.integer("every", 0, 100000));
+  options.augmentation_every_n = static_cast<int>(args.integer("augment-every", 0, 100000));
   options.hierarchy = voxels::parse_hierarchy(args);
   options.crop_augmentation = !args.flag("no-crop-augmentation");
   options.keep_failed = args.flag("keep-failed");
   options.demo = !args.flag("not-demo");
   options.seed = args.seed();
 
-  stream::WriteOptions write_options;
-  if (args.flag("append")) write_options.mode = stream::WriteMode::append;
-  write_options.repair = args.flag("repair");
-  write_options.inputs = {args.input()};
+  const stream::WriteOptions write_options = stream::write_options_from(args, {args.input()});
   stream::RecordReader reader(args.input());
   stream::RecordWriter writer(args.text("output"), write_options);
   const auto convert_all = [&](auto&& converter) {

@@ -1,6 +1,7 @@
 // plan-path: next-best poses to collision-free joint trajectories on the sensed scene.
 #include "cli/command.hpp"
 #include "planning/motion_planner.hpp"
+#include "planning/planner_options.hpp"
 #include "point_clouds/cloud_filters.hpp"
 #include "stream/reader.hpp"
 #include "stream/stage.hpp"
@@ -34,14 +35,10 @@ static cli::Usage usage() {
   };
   u.arguments = {cli::input_file()};
   u.options = {
-      {"time-budget", "S", "seconds RRT-Connect may search before reporting timeout", "2"},
-      {"velocity-scale", "F", "fraction of the joints' 180 deg/s to move at", "0.5"},
-      {"acceleration", "A", "joint acceleration limit, rad/s^2", "8"},
-      {"clearance", "M", "extra distance in metres kept from occupied voxels", "0"},
-      {"resolution", "M", "OctoMap voxel size in metres", "0.01"},
       {"octomap", "FILE.bt", "write the scene map of the last planned action (opens in octovis)", ""},
   };
   u.options.push_back(cli::output_file());
+  u.add_options(planning::planner_options());
   u.add_options(point_clouds::cloud_filter_options());
   u.uses_randomness = true;
   u.examples = {
@@ -55,13 +52,7 @@ static cli::Usage usage() {
 }
 
 static void run(const cli::Arguments& args) {
-  planning::PlannerOptions options;
-  options.time_budget_s = args.real("time-budget", 0.001, 600);
-  options.velocity_scale = args.real("velocity-scale", 0.01, 1);
-  options.max_acceleration_rad_s2 = args.real("acceleration", 0.1, 1000);
-  options.clearance_m = args.real("clearance", 0, 0.5);
-  options.scene.resolution_m = args.real("resolution", 0.002, 0.1);
-  options.seed = args.seed();
+  const planning::PlannerOptions options = planning::planner_options_from(args);
   const robot::RobotModel robot = robot::RobotModel::xarm7();
   const Eigen::Isometry3d world_from_base = world::SceneLayout{}.robot_base_pose();
   planning::PlanPathFilter filter(robot, world_from_base, options);

@@ -1,9 +1,8 @@
 // qattn-train: the learner. Replayed transitions in, Q-attention network checkpoints out.
-#include <unistd.h>
-
 #include <iostream>
 
 #include "cli/command.hpp"
+#include "learner/learner_options.hpp"
 #include "learner/q_learner.hpp"
 #include "learner/training_files.hpp"
 #include "learner/training_loop.hpp"
@@ -71,42 +70,14 @@ static cli::Usage usage() {
   u.arguments = {{"FILE", "frame and transition records; '-' is standard input (at least one)", true, true}};
   u.options = {
       {"checkpoint-dir", "DIR", "where checkpoints go (required)", ""},
-      {"steps", "N", "gradient steps to reach (0: write the initial networks and exit)", "1000"},
       {"resume", "", "continue from DIR/latest.rec when it exists", ""},
-      {"follow", "", "keep reading the inputs as they grow; pace training by --replay-ratio", ""},
-      {"stop-file", "FILE", "with --follow: finish once FILE exists and the allowed steps are done", ""},
-      {"replay-ratio", "R", "with --follow: gradient steps per agent transition", "1"},
       {"steps-allowed", "N", "print the gradient steps --follow allows after N agent transitions (with --pretrain and "
                              "--replay-ratio) and exit: the pacing rule, for scripts that wait on the learner", ""},
-      {"pretrain", "N", "with --follow: steps allowed before any agent transition, on the demonstrations even below --start-after", "0"},
-      {"start-after", "N", "train once the replay holds N transitions (demos included)", "200"},
-      {"checkpoint-every", "N", "steps between checkpoints", "100"},
       {"keep", "N", "numbered checkpoints to keep", "3"},
-      {"metrics", "FILE", "CSV of training figures", ""},
-      {"log-every", "N", "steps between metrics rows and progress lines", "10"},
-      {"architecture", "A", "network per depth: light or arm", "light"},
-      {"base-channels", "C", "first-level kernels (default: light 16, arm 64)", ""},
-      {"batch", "B", "transitions per step (published: 128)", "32"},
-      {"gamma", "G", "discount", "0.99"},
-      {"reward-scale", "F", "reward multiplier in the target", "0.01"},
-      {"tau", "T", "soft target update rate per step", "0.0025"},
-      {"lr", "R", "Adam learning rate", "0.0005"},
-      {"weight-decay", "W", "Adam weight decay", "0.000001"},
-      {"grad-clip-value", "C", "clip every gradient element to +-C, per depth (published; 0: none)", "0.01"},
-      {"grad-clip-norm", "N", "clip each depth's gradient L2 norm to N (0: none)", "0"},
-      {"q-reg", "L", "lambda of the lambda * mean|Q| regularisation", "1"},
-      {"huber-delta", "D", "Huber loss threshold", "1"},
-      {"tree-target", "K", "bootstrap with tree expansion of K branches per non-leaf grid, ranked by the online and valued by the target networks (0: double DQN down the greedy path); 'auto': as many as each node's Q volume asks for (--k-margin or --k-mass, at most --k-max)", "0"},
-      {"n-step", "N", "bootstrap after N transitions of a chain, summing their discounted rewards", "1"},
-      {"uniform", "", "uniform replay sampling instead of prioritised", ""},
-      {"alpha", "A", "priority exponent", "0.7"},
-      {"beta", "B", "importance-weight exponent: (N p)^-B over its batch maximum (published: 1/sqrt(p), B = 0.5)", "0.5"},
-      {"capacity", "N", "replay capacity in transitions (demos always kept)", "100000"},
-      {"threads", "N",
-       "LibTorch threads; with more than 1 the program sets OMP_WAIT_POLICY=PASSIVE for itself unless it is set "
-       "(spinning OpenMP threads slow a program sharing the cores), at the price of a second start (~0.4 s)",
-       "2"},
   };
+  u.add_options(learner::loop_options());
+  u.add_options(learner::learner_config_options());
+  u.add_options(learner::replay_options());
   u.add_options(voxels::hierarchy_options());
   u.add_options(qattention::branching_options());
   u.uses_randomness = true;
@@ -122,50 +93,15 @@ static cli::Usage usage() {
 }
 
 static void run(const cli::Arguments& args) {
-  learner::LearnerConfig config;
-  config.net.architecture = nets::architecture_from_name(args.text("architecture"));
-  config.net.base_channels = args.has("base-channels") ? static_cast<int>(args.integer("base-channels", 1, 512))
-                                                       : nets::default_base_channels(config.net.architecture);
-  config.hierarchy = voxels::parse_hierarchy(args, 4, 128);  // the networks' smallest and largest grids
-  config.batch = static_cast<int>(args.integer("batch", 1, 100000));
-  config.gamma = args.real("gamma", 0, 1);
-  config.reward_scale = args.real("reward-scale", 1e-9, 1e9);
-  config.tau = args.real("tau", 0, 1);
-  config.learning_rate = args.real("lr", 1e-12, 1e30);  // any positive rate (a test diverges on purpose)
-  config.weight_decay = args.real("weight-decay", 0, 1e3);
-  config.grad_clip_value = args.real("grad-clip-value", 0, 1e12);
-  config.grad_clip_norm = args.real("grad-clip-norm", 0, 1e12);
-  config.q_regularisation = args.real("q-reg", 0, 1e6);
-  config.huber_delta = args.real("huber-delta", 1e-9, 1e9);
-  config.tree_branching = qattention::parse_branching(args, "tree-target", 0);
-  config.tree_target_k = config.tree_branching.k;
-  config.n_step = static_cast<int>(args.integer("n-step", 1, 10));
-  config.validate();
-  config.check_memory(static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE)));
-
-  learner::LoopOptions loop;
-  loop.steps = args.integer("steps", 0, 1000000000000);
-  loop.start_after = args.integer("start-after", 0, 1000000000000);
-  loop.pretrain = args.integer("pretrain", 0, 1000000000000);
-  loop.replay_ratio = args.real("replay-ratio", 0, 1e6);
-  loop.beta = args.real("beta", 0, 1);
-  loop.follow = args.flag("follow");
-  loop.stop_file = args.text("stop-file");
-  loop.checkpoint_every = args.integer("checkpoint-every", 1, 1000000000000);
-  loop.log_every = args.integer("log-every", 1, 1000000000000);
-  loop.metrics_path = args.text("metrics");
-  loop.seed = args.seed();
-  loop.threads = static_cast<int>(args.integer("threads", 1, 256));
+  const learner::LearnerConfig config = learner::learner_config_from(args);
+  const learner::LoopOptions loop = learner::loop_options_from(args);
   if (args.has("steps-allowed")) {
     std::cout << learner::allowed_steps(loop, args.integer("steps-allowed", 0, INT64_MAX)) << "\n";
     return;
   }
   if (!args.has("checkpoint-dir")) throw UsageError("--checkpoint-dir is required");
   if (args.positional().empty()) throw UsageError("missing argument FILE");
-  replay::ReplayOptions replay_options;
-  replay_options.capacity = static_cast<std::size_t>(std::max<int64_t>(1, args.integer("capacity", 1, 1000000000)));
-  replay_options.prioritised = !args.flag("uniform");
-  replay_options.alpha = args.real("alpha", 0, 10);
+  const replay::ReplayOptions replay_options = learner::replay_options_from(args);
 
   nets::set_torch_threads(loop.threads);
   nets::seed_torch(loop.seed);

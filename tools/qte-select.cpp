@@ -70,13 +70,7 @@ static cli::Usage usage() {
       {"gripper-flip", "P", "probability of flipping the gripper command", "0"},
       {"ignore-collisions", "", "set ignore_collisions in every action (straight-line moves)", ""},
       {"reload", "", "at the start of each episode, load the checkpoint again when the file changed", ""},
-      {"threads", "N",
-       "LibTorch threads; with more than 1 the program sets OMP_WAIT_POLICY=PASSIVE for itself unless it is set "
-       "(OpenMP threads that spin while they wait make a forward about 50 times slower when a busy process, the "
-       "learner, shares the cores), at the price of a second start (~0.4 s). Outputs are the same "
-       "bytes for the same --threads; another count sums in another order, so Q values may differ in "
-       "their last bit (measured: the same voxels in 19 of 19 actions, 3 values 1e-7 apart)",
-       "2"},
+      nets::torch_threads_option(2),
       {"png", "DIR", "save the Q-values of every depth's grid as DIR/<n>.depth<d>.png (all at the end of the input, or none)", ""},
   };
   u.options.push_back(cli::output_file());

@@ -7,11 +7,13 @@
 #include <set>
 
 #include "cli/command.hpp"
+#include "common/indexed_name.hpp"
 #include "common/atomic_file.hpp"
 #include "point_clouds/pcd_file.hpp"
 #include "stream/inspect.hpp"
 #include "stream/npy.hpp"
 #include "stream/reader.hpp"
+#include "stream/stream_options.hpp"
 
 using namespace qte;
 
@@ -51,8 +53,7 @@ static cli::Usage usage() {
       {"per-record", "", "with --npy, write one .npy file per record and field instead of stacked arrays", ""},
       {"pcd", "DIR", "also export every camera's point cloud of the shown observations as .pcd files into DIR", ""},
       {"summary", "", "print only a count of records and bytes per type at the end", ""},
-      {"max-record-bytes", "N", "treat a record payload or decompressed field larger than N bytes as damage",
-       std::to_string(uint64_t(4) << 30)},
+      stream::max_record_bytes_option(),
   };
   u.examples = {
       {"stream-dump demos.rec", "list every record of a file with its fields"},
@@ -89,8 +90,7 @@ static void run(const cli::Arguments& args) {
   OutputDirectory* pcd = pcd_out ? pcd_out.get() : args.has("pcd") ? npy_out.get() : nullptr;
   std::unique_ptr<stream::NpyExport> npy;
   if (npy_out) npy = std::make_unique<stream::NpyExport>(npy_out->staging(), args.flag("per-record"));
-  stream::ReadOptions read_options;
-  read_options.max_record_bytes = static_cast<uint64_t>(args.integer("max-record-bytes", 1, INT64_MAX));
+  const stream::ReadOptions read_options = stream::read_options_from(args);
 
   std::map<std::string, std::pair<uint64_t, uint64_t>> totals;  // type -> (records, bytes)
   for (const std::string& file : files) {
@@ -103,11 +103,9 @@ static void run(const cli::Arguments& args) {
       auto& total = totals[record->type()];
       total.first += 1;
       total.second += bytes;
-      char index[16];
-      std::snprintf(index, sizeof index, "%06llu", static_cast<unsigned long long>(record->position.record_index));
       if (pcd && (record->type() == "obs" || record->type() == "frame"))
         for (const auto& camera : voxels::camera_clouds(*record))
-          point_clouds::write_pcd(pcd->path(std::string(index) + "." + camera.camera + ".pcd"), camera);
+          point_clouds::write_pcd(pcd->path(indexed_name(record->position.record_index, camera.camera + ".pcd")), camera);
       if (npy) npy->add(*record);
       if (args.flag("summary")) continue;
       if (args.flag("json")) stream::print_record_json(std::cout, *record, bytes, inspect);

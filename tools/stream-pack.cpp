@@ -1,6 +1,7 @@
 // stream-pack: write one record from command-line values and .npy files.
 #include "cli/command.hpp"
 #include "stream/field_spec.hpp"
+#include "stream/stream_options.hpp"
 #include "stream/writer.hpp"
 
 using namespace qte;
@@ -23,10 +24,9 @@ static cli::Usage usage() {
   u.arguments = {{"TYPE", "record type, 1-16 characters of [a-z0-9_] (e.g. reset)", false, false},
                  {"FIELD", "field specifications, see above", true, true}};
   u.options = {
-      {"append", "", "append to --output instead of replacing it", ""},
-      {"repair", "", "with --append: cut a torn last record (left by a killed writer) off --output instead of refusing to append behind it", ""},
       {"compress", "", "zstd-compress arrays of 256 bytes or more", ""},
   };
+  u.add_options(stream::append_options());
   u.options.push_back(cli::output_file());
   u.examples = {
       {"stream-pack reset task=reach_target variation:i32=0 seed:i64=7 > reset.rec",
@@ -51,10 +51,7 @@ static void run(const cli::Arguments& args) {
     }
     record = std::move(compressed);
   }
-  stream::WriteOptions options;
-  if (args.flag("append")) options.mode = stream::WriteMode::append;
-  options.repair = args.flag("repair");
-  stream::RecordWriter writer(args.text("output"), options);
+  stream::RecordWriter writer(args.text("output"), stream::write_options_from(args, {}));
   writer.write(record);
   writer.close();
 }

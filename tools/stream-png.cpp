@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "cli/command.hpp"
+#include "common/indexed_name.hpp"
 #include "common/atomic_file.hpp"
 #include "render/camera.hpp"
 #include "stream/reader.hpp"
@@ -62,10 +63,8 @@ static cli::Usage usage() {
 namespace {
 
 void save_pngs(const stream::Record& record, const OutputDirectory& dir, bool depth, bool depth_mm) {
-  char index[16];
-  std::snprintf(index, sizeof index, "%06llu", static_cast<unsigned long long>(record.position.record_index));
   for (const auto& field : record.fields()) {
-    const std::string path = dir.path(std::string(index) + "." + field.name());
+    const std::string path = dir.path(indexed_name(record.position.record_index, field.name()));
     if (stream::ends_with(field.name(), ".rgb")) render::save_rgb_png(path + ".png", video::image_field(record, field, false));
     if (!stream::ends_with(field.name(), ".depth") || !(depth || depth_mm)) continue;
     const cv::Mat metres = video::image_field(record, field, true);

@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "cli/command.hpp"
+#include "common/indexed_name.hpp"
 #include "common/atomic_file.hpp"
 #include "robot/xarm_export.hpp"
 #include "stream/reader.hpp"
@@ -53,12 +54,12 @@ static void run(const cli::Arguments& args) {
   const double rate = args.real("rate", 1, 1000), settle = args.real("settle", 0, 60);
   OutputDirectory out(dir);
   const robot::RobotModel robot = robot::RobotModel::xarm7();
-  double gripper_m = robot.max_finger_opening_m();  // open until an observation says otherwise
+  robot::XarmEpisode episode(robot, rate, settle);
   for (const std::string& file : files) {
     stream::RecordReader reader(file);
     while (auto record = reader.next()) {
       if (record->type() == "obs" && record->has("gripper_opening_m"))
-        gripper_m = record->scalar<double>("gripper_opening_m");
+        episode.observe_gripper(record->scalar<double>("gripper_opening_m"));
       if (record->type() != "trajectory") continue;
       const auto index = static_cast<unsigned long long>(record->position.record_index);
       if (record->has("failure") && !record->has("time_s")) {
@@ -70,21 +71,18 @@ static void run(const cli::Arguments& args) {
       if (times.shape.size() != 1 || joints.shape != stream::Shape{times.size(), robot::kArmJoints})
         record->fail("joint_positions", "float64 [N, 7] with N the length of time_s");
       const bool open = !record->has("gripper_open") || record->scalar<uint8_t>("gripper_open") != 0;
-      const double after_m = open ? robot.max_finger_opening_m() : 0.0;
       std::vector<robot::XarmRow> rows;
       try {
-        rows = robot::xarm_rows(times.data, joints.data, times.size(), gripper_m, after_m, robot, rate, settle);
+        rows = episode.motion(times.data, joints.data, times.size(), open);
       } catch (const Error& e) {
         throw StreamError(record->position, e.what());
       }
-      char name[32];
-      std::snprintf(name, sizeof name, "%06llu.xarm.csv", index);
+      const std::string name = indexed_name(index, "xarm.csv");
       const std::string comment = "# xArm 7 joint trajectory: " + file + ", record " + std::to_string(index) +
                                   "\n# rows every " + std::to_string(1.0 / rate) +
                                   " s; joints in degrees; gripper 0 (closed) .. 850 (open)\n";
       const std::string csv = robot::xarm_csv(rows, comment);
       out.write_file(name, csv.data(), csv.size());
-      gripper_m = after_m;
     }
   }
   out.commit();

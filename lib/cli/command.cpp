@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "common/error.hpp"
+#include "common/number_list.hpp"
 
 #ifndef QTE_VERSION
 #define QTE_VERSION "unknown"
@@ -123,6 +124,22 @@ bool Arguments::has(const std::string& name) const { return given_.count(name) >
 
 bool Arguments::flag(const std::string& name) const { return has(name); }
 
+std::vector<std::pair<std::string, std::string>> Arguments::assignments(const std::string& name) const {
+  std::vector<std::pair<std::string, std::string>> pairs;
+  for (const std::string& item : all(name)) {
+    const std::size_t equals = item.find('=');
+    if (equals == std::string::npos || equals == 0)
+      throw UsageError("--" + name + ": expected NAME=VALUE, got '" + item + "'");
+    pairs.emplace_back(item.substr(0, equals), item.substr(equals + 1));
+  }
+  return pairs;
+}
+
+bool Arguments::declared(const std::string& name) const {
+  const auto options = all_options(*usage_);
+  return find_option(options, name) != nullptr;
+}
+
 std::string Arguments::text(const std::string& name) const {
   auto it = given_.find(name);
   if (it != given_.end()) return it->second.back();
@@ -171,6 +188,18 @@ double Arguments::real(const std::string& name, double lo, double hi) const {
   return x;
 }
 
+std::string default_text(int64_t value) { return std::to_string(value); }
+
+std::string default_text(double value) {
+  char text[64];
+  for (int decimals = 0; decimals <= 17; ++decimals) {
+    std::snprintf(text, sizeof text, "%.*f", decimals, value);
+    if (std::strtod(text, nullptr) == value) return text;
+  }
+  std::snprintf(text, sizeof text, "%.17g", value);
+  return text;
+}
+
 std::pair<double, double> Arguments::range(const std::string& name) const {
   const std::vector<double> v = parse_reals(name, text(name), 2);
   if (!(v[0] < v[1])) throw UsageError("--" + name + ": expected LO,HI with LO < HI, got '" + text(name) + "'");
@@ -208,16 +237,8 @@ std::vector<double> Arguments::reals(const std::string& name, std::size_t count)
 
 std::vector<double> parse_reals(const std::string& option, const std::string& text, std::size_t count) {
   std::vector<double> v;
-  std::stringstream in(text);
-  for (std::string item; std::getline(in, item, ',');) {
-    try {
-      std::size_t used = 0;
-      v.push_back(std::stod(item, &used));
-      if (used != item.size() || !std::isfinite(v.back())) throw std::invalid_argument(item);
-    } catch (const std::exception&) {
-      throw UsageError("--" + option + ": '" + item + "' is not a finite number");
-    }
-  }
+  std::string bad;
+  if (!parse_number_list(text, v, bad)) throw UsageError("--" + option + ": '" + bad + "' is not a finite number");
   if (v.size() != count)
     throw UsageError("--" + option + ": expected " + std::to_string(count) + " comma-separated numbers");
   return v;

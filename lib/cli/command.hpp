@@ -27,6 +27,14 @@ struct ArgumentSpec {
   bool variadic = false;  // takes the remaining arguments
 };
 
+// An option's default as text, from the setting's own initial value (so the value has one home,
+// its struct): integers as they are, reals in the fewest plain decimals that read back the same
+// (0.000001, not 1e-06).
+std::string default_text(double value);
+std::string default_text(int64_t value);
+inline std::string default_text(int value) { return default_text(static_cast<int64_t>(value)); }
+inline std::string default_text(std::size_t value) { return default_text(static_cast<int64_t>(value)); }
+
 // The record-stream input of a filter: one FILE, '-' or absent meaning standard input
 // (read with Arguments::input()).
 ArgumentSpec input_file(const std::string& what = "input records");
@@ -59,7 +67,8 @@ struct Usage {
 class Arguments {
  public:
   bool flag(const std::string& name) const;
-  bool has(const std::string& name) const;  // given on the command line
+  bool has(const std::string& name) const;       // given on the command line
+  bool declared(const std::string& name) const;  // an option of this tool (for groups shared in part)
   std::string text(const std::string& name) const;
   // Every number from a user is range-checked here: an integer outside lo..hi (no value wraps
   // when a tool narrows it), or a real that is not finite or outside lo..hi, is a UsageError.
@@ -74,6 +83,8 @@ class Arguments {
   // Exactly `count` comma-separated finite numbers ("0.1,0,0.8"), or a UsageError naming the option.
   std::vector<double> reals(const std::string& name, std::size_t count) const;
   std::vector<std::string> all(const std::string& name) const;  // repeatable options
+  // Every NAME=VALUE of a repeatable option, in order (NAME not empty, VALUE may be).
+  std::vector<std::pair<std::string, std::string>> assignments(const std::string& name) const;
   const std::vector<std::string>& positional() const { return positional_; }
   std::string input() const { return positional_.empty() ? "-" : positional_[0]; }
   std::vector<std::string> inputs() const {

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/command.hpp"
 #include "robot/rotation_bins.hpp"
 
 namespace qte::nets {
@@ -108,6 +109,8 @@ void seed_torch(uint64_t seed);
 // 50x slower. One thread starts no workers and is not executed again: a start of LibTorch
 // costs ~0.4 s of processor time, and the actor starts once per chunk of episodes.
 void set_torch_threads(int threads);
+// --threads, the option of set_torch_threads (qte-select, qattn-train).
+cli::OptionSpec torch_threads_option(int default_threads);
 
 // Programs that run networks call this first thing in main(): it keeps argv for
 // set_torch_threads and keeps freed activations in the heap for the next forward (see the .cpp).

@@ -92,7 +92,7 @@ MotionPlanner::MotionPlanner(const robot::RobotModel& robot, const Eigen::Isomet
       world_from_base_(world_from_base),
       options_(options),
       spheres_(robot),
-      checker_(spheres_, world_from_base, {options.clearance_m, options.check_step_rad, options.table_height_m}) {
+      checker_(spheres_, world_from_base, options.collision) {
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
 }
 
@@ -243,7 +243,7 @@ PlanResult MotionPlanner::rrt_connect(const StartState& start, const robot::Join
   og::SimpleSetup setup(space);
   const double opening = start.opening_m;
   setup.setStateValidityChecker([&](const ob::State* s) { return checker_.state_valid(to_joints(s), opening, &scene); });
-  setup.getSpaceInformation()->setStateValidityCheckingResolution(options_.check_step_rad / space->getMaximumExtent());
+  setup.getSpaceInformation()->setStateValidityCheckingResolution(options_.collision.check_step_rad / space->getMaximumExtent());
   ob::ScopedState<> from(space), to(space);
   for (int k = 0; k < robot::kArmJoints; ++k) {
     from[k] = start.joints[k];

@@ -28,11 +28,9 @@ struct PlannerOptions {
   double velocity_scale = 0.5;         // of the joints' 180 deg/s
   double max_acceleration_rad_s2 = 8;  // per joint
   double sample_period_s = 0.05;       // trajectory samples (sim-step's control period)
-  double clearance_m = 0.0;            // extra distance kept from occupied voxels
-  double check_step_rad = 0.02;        // collision checks along motions, largest joint step
   double straight_step_m = 0.01;       // TCP step of straight-line moves
   double goal_free_radius_m = 0.06;    // around the goal TCP, points are not obstacles
-  double table_height_m = world::SceneLayout::kTableHeight_m;  // under the table top (unseen) is never free
+  CollisionCheckOptions collision;     // clearance, check step, the table (under its top is never free)
   uint64_t seed = 0;
   SceneOptions scene;
 };

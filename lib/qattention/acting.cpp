@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "common/error.hpp"
+#include "common/indexed_name.hpp"
 #include "qattention/proprio.hpp"
 #include "stream/reader.hpp"
 #include "voxels/grid_fields.hpp"
@@ -105,7 +106,6 @@ Action act(const DepthEvaluator& evaluate, const voxels::CoarseToFine& hierarchy
 
 void save_q_pictures(const std::string& dir, uint64_t index, Action& action) {
   const Choice& c = action.choice;
-  char name[32];
   for (int d = 0; d < static_cast<int>(c.indices.size()); ++d) {
     const GridQ& g = action.grids.at(d);
     const int v = c.bounds[d].voxels;
@@ -119,8 +119,8 @@ void save_q_pictures(const std::string& dir, uint64_t index, Action& action) {
     picture.marked_x = c.indices[d].x();
     picture.marked_y = c.indices[d].y();
     picture.marked_z = c.indices[d].z();
-    std::snprintf(name, sizeof name, "/%06llu.depth%d.png", static_cast<unsigned long long>(index), d);
-    voxels::save_voxel_png(dir + name, g.grid.data(), v, picture);
+    voxels::save_voxel_png(dir + "/" + indexed_name(index, "depth" + std::to_string(d) + ".png"), g.grid.data(), v,
+                           picture);
   }
 }
 

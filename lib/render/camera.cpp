@@ -11,7 +11,7 @@
 #include <thread>
 #include <vector>
 
-#include "common/atomic_file.hpp"
+#include "common/png_file.hpp"
 #include "common/error.hpp"
 #include "render/ray_caster.hpp"
 
@@ -206,17 +206,13 @@ void save_rgb_png(const std::string& path, const cv::Mat& rgb) {
     throw Error("save_rgb_png: " + path + ": need an 8-bit RGB image (CV_8UC3)");
   cv::Mat bgr;
   cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);  // OpenCV's codecs take BGR
-  std::vector<uchar> png;
-  if (!cv::imencode(".png", bgr, png)) throw Error("cannot encode " + path + " as PNG");
-  write_file_atomically(path, png.data(), png.size());
+  write_png(path, bgr);
 }
 
 void save_mm_png(const std::string& path, const cv::Mat& millimetres) {
   if (millimetres.empty() || millimetres.type() != CV_16UC1)
     throw Error("save_mm_png: " + path + ": need a 16-bit depth image (CV_16UC1)");
-  std::vector<uchar> png;
-  if (!cv::imencode(".png", millimetres, png)) throw Error("cannot encode " + path + " as PNG");
-  write_file_atomically(path, png.data(), png.size());
+  write_png(path, millimetres);
 }
 
 void save_depth_png(const std::string& path, const cv::Mat& depth) {
@@ -233,9 +229,7 @@ void save_depth_png(const std::string& path, const cv::Mat& depth) {
   cv::Mat bgr;
   cv::applyColorMap(level, bgr, cv::COLORMAP_TURBO);
   bgr.setTo(cv::Scalar::all(0), ~valid);
-  std::vector<uchar> png;
-  if (!cv::imencode(".png", bgr, png)) throw Error("cannot encode " + path + " as PNG");
-  write_file_atomically(path, png.data(), png.size());
+  write_png(path, bgr);
 }
 
 }  // namespace qte::render

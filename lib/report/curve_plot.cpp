@@ -7,7 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "common/atomic_file.hpp"
+#include "common/png_file.hpp"
 #include "common/error.hpp"
 
 namespace qte::report {
@@ -445,12 +445,6 @@ cv::Mat draw_panels(const std::vector<CurvePanel>& panels, const CurvePlotOption
   return image;
 }
 
-std::vector<uint8_t> encode_png(const cv::Mat& image, const std::string& what) {
-  std::vector<uint8_t> png;
-  if (!cv::imencode(".png", image, png)) throw Error("cannot encode " + what + " as PNG");
-  return png;
-}
-
 }  // namespace
 
 std::vector<uint8_t> curve_plot_png(const std::vector<Curve>& curves, const CurvePlotOptions& options) {
@@ -458,8 +452,7 @@ std::vector<uint8_t> curve_plot_png(const std::vector<Curve>& curves, const Curv
 }
 
 void save_curve_plot(const std::string& path, const std::vector<Curve>& curves, const CurvePlotOptions& options) {
-  const std::vector<uint8_t> png = encode_png(draw_curves(curves, options), path);
-  write_file_atomically(path, png.data(), png.size());
+  write_png(path, draw_curves(curves, options));
 }
 
 std::vector<uint8_t> panel_plot_png(const std::vector<CurvePanel>& panels, const CurvePlotOptions& options,
@@ -469,8 +462,7 @@ std::vector<uint8_t> panel_plot_png(const std::vector<CurvePanel>& panels, const
 
 void save_panel_plot(const std::string& path, const std::vector<CurvePanel>& panels, const CurvePlotOptions& options,
                      int columns) {
-  const std::vector<uint8_t> png = encode_png(draw_panels(panels, options, columns), path);
-  write_file_atomically(path, png.data(), png.size());
+  write_png(path, draw_panels(panels, options, columns));
 }
 
 }  // namespace qte::report

@@ -59,4 +59,13 @@ std::string xarm_csv(const std::vector<XarmRow>& rows, const std::string& commen
   return out;
 }
 
+std::vector<XarmRow> XarmEpisode::motion(const double* time_s, const double* joints, int64_t n,
+                                         bool gripper_open_after) {
+  const double before_m = gripper_m_.value_or(robot_.max_finger_opening_m());
+  const double after_m = gripper_open_after ? robot_.max_finger_opening_m() : 0.0;
+  std::vector<XarmRow> rows = xarm_rows(time_s, joints, n, before_m, after_m, robot_, rate_hz_, settle_s_);
+  gripper_m_ = after_m;  // only once the motion is accepted
+  return rows;
+}
+
 }  // namespace qte::robot

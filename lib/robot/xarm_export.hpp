@@ -3,6 +3,7 @@
 // (0 closed .. 850 open), checked against the joint limits and speeds before anything is written.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,22 @@ struct XarmRow {
 // checked on the waypoints and again on the rows.
 std::vector<XarmRow> xarm_rows(const double* time_s, const double* joints, int64_t n, double gripper_before_m,
                                double gripper_after_m, const RobotModel& robot, double rate_hz, double settle_s = 0.5);
+
+// The motions of an episode in order, as xarm_rows() of each: during a motion the gripper holds
+// what the last observation said (open before any observation), or what the motion before it
+// commanded; after the motion it goes to the motion's own command.
+class XarmEpisode {
+ public:
+  XarmEpisode(const RobotModel& robot, double rate_hz, double settle_s)
+      : robot_(robot), rate_hz_(rate_hz), settle_s_(settle_s) {}
+  void observe_gripper(double opening_m) { gripper_m_ = opening_m; }
+  std::vector<XarmRow> motion(const double* time_s, const double* joints, int64_t n, bool gripper_open_after);
+
+ private:
+  const RobotModel& robot_;
+  double rate_hz_, settle_s_;
+  std::optional<double> gripper_m_;  // none: nothing observed yet, open
+};
 
 // CSV: a comment header saying what the columns are, then time_s,j1..j7 (degrees),gripper.
 std::string xarm_csv(const std::vector<XarmRow>& rows, const std::string& comment);

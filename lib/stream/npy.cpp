@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "common/atomic_file.hpp"
+#include "common/indexed_name.hpp"
 
 namespace qte::stream {
 
@@ -145,9 +146,7 @@ NpyExport::~NpyExport() {
 }
 
 std::string NpyExport::per_record_path(uint64_t record_index, const Key& key) const {
-  char index[24];
-  std::snprintf(index, sizeof index, "%06llu", static_cast<unsigned long long>(record_index));
-  return dir_ + "/" + index + "." + key.first + "." + key.second + ".npy";
+  return dir_ + "/" + indexed_name(record_index, key.first + "." + key.second + ".npy");
 }
 
 bool NpyExport::fits(const Stack& stack, const Field& field) const {

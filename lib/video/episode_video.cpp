@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/error.hpp"
+#include "common/indexed_name.hpp"
 
 namespace qte::video {
 
@@ -55,9 +56,8 @@ void EpisodeVideo::write(const Frame& frame, bool acted_on) {
 std::vector<cv::Mat> EpisodeVideo::attention_pictures() {
   std::vector<cv::Mat> pictures;
   for (int d = 0; action_ >= 0; ++d) {
-    char name[64];
-    std::snprintf(name, sizeof name, "/%06lld.depth%d.png", static_cast<long long>(action_), d);
-    const std::string path = attention_dir_ + name;
+    const std::string path =
+        attention_dir_ + "/" + indexed_name(static_cast<uint64_t>(action_), "depth" + std::to_string(d) + ".png");
     struct stat st;
     if (::stat(path.c_str(), &st) != 0) break;  // no deeper picture (asking OpenCV would warn)
     cv::Mat bgr = cv::imread(path, cv::IMREAD_COLOR);

@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "common/error.hpp"
+#include "common/number_list.hpp"
 
 namespace qte::voxels {
 namespace {
@@ -13,15 +14,9 @@ namespace {
 // "A,B,C" as numbers; throws Error naming `what` and the item that is not one.
 std::vector<double> parse_numbers(const std::string& text, const char* what) {
   std::vector<double> values;
-  std::size_t at = 0;
-  while (at <= text.size()) {
-    const std::size_t comma = std::min(text.find(',', at), text.size());
-    const std::string item = text.substr(at, comma - at);
-    char* end = nullptr;
-    values.push_back(std::strtod(item.c_str(), &end));
-    if (item.empty() || *end != '\0') throw Error(std::string(what) + " '" + text + "': '" + item + "' is not a number");
-    at = comma + 1;
-  }
+  std::string bad;
+  if (!parse_number_list(text, values, bad))
+    throw Error(std::string(what) + " '" + text + "': '" + bad + "' is not a finite number");
   return values;
 }
 

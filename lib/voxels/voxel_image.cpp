@@ -5,7 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "common/atomic_file.hpp"
+#include "common/png_file.hpp"
 #include "common/error.hpp"
 #include "voxels/voxel_grid.hpp"
 
@@ -94,9 +94,7 @@ void save_voxel_png(const std::string& path, const float* grid, int voxels, cons
                  cv::Scalar(0, 0, 255), 2, cv::LINE_AA);
       }
   }
-  std::vector<uint8_t> png;
-  if (!cv::imencode(".png", image, png)) throw Error("cannot encode " + path + " as PNG");
-  write_file_atomically(path, png.data(), png.size());
+  write_png(path, image);
 }
 
 }  // namespace qte::voxels

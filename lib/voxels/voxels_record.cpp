@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "voxels/grid_fields.hpp"
+#include "common/indexed_name.hpp"
 #include "voxels/observation_cloud.hpp"
 #include "voxels/occupancy_channels.hpp"
 #include "voxels/voxel_image.hpp"
@@ -57,11 +58,9 @@ void VoxelizeStage::handle(const stream::Record& record, const stream::Emit& emi
 void VoxelizeStage::save_pictures(uint64_t record_index, const std::vector<float>& grids) const {
   const int v = options_.scene.voxels;
   const std::size_t grid_floats = static_cast<std::size_t>(v) * v * v * kChannels;
-  char index[24];
-  std::snprintf(index, sizeof index, "%06llu", static_cast<unsigned long long>(record_index));
-  save_voxel_png(png_dir_ + "/" + index + ".depth0.png", grids.data(), v);
+  save_voxel_png(png_dir_ + "/" + indexed_name(record_index, "depth0.png"), grids.data(), v);
   for (std::size_t c = 0; c < options_.crops.size(); ++c)
-    save_voxel_png(png_dir_ + "/" + index + ".depth1." + std::to_string(c) + ".png",
+    save_voxel_png(png_dir_ + "/" + indexed_name(record_index, "depth1." + std::to_string(c) + ".png"),
                    grids.data() + (1 + c) * grid_floats, v);
 }
 

@@ -1,0 +1,119 @@
+#include "learner/learner_options.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdint>
+
+#include "nets/qattention_net.hpp"
+#include "qattention/branching_options.hpp"
+#include "voxels/hierarchy_options.hpp"
+
+namespace qte::learner {
+
+using cli::default_text;
+
+std::vector<cli::OptionSpec> learner_config_options() {
+  const LearnerConfig d;
+  return {
+      {"architecture", "A", "network per depth: light or arm", nets::architecture_name(d.net.architecture)},
+      {"base-channels", "C", "first-level kernels (default: light 16, arm 64)", ""},
+      {"batch", "B", "transitions per step (published: 128)", default_text(d.batch)},
+      {"gamma", "G", "discount", default_text(d.gamma)},
+      {"reward-scale", "F", "reward multiplier in the target", default_text(d.reward_scale)},
+      {"tau", "T", "soft target update rate per step", default_text(d.tau)},
+      {"lr", "R", "Adam learning rate", default_text(d.learning_rate)},
+      {"weight-decay", "W", "Adam weight decay", default_text(d.weight_decay)},
+      {"grad-clip-value", "C", "clip every gradient element to +-C, per depth (published; 0: none)",
+       default_text(d.grad_clip_value)},
+      {"grad-clip-norm", "N", "clip each depth's gradient L2 norm to N (0: none)", default_text(d.grad_clip_norm)},
+      {"q-reg", "L", "lambda of the lambda * mean|Q| regularisation", default_text(d.q_regularisation)},
+      {"huber-delta", "D", "Huber loss threshold", default_text(d.huber_delta)},
+      {"tree-target", "K",
+       "bootstrap with tree expansion of K branches per non-leaf grid, ranked by the online and valued by the "
+       "target networks (0: double DQN down the greedy path); 'auto': as many as each node's Q volume asks for "
+       "(--k-margin or --k-mass, at most --k-max)",
+       default_text(d.tree_target_k)},
+      {"n-step", "N", "bootstrap after N transitions of a chain, summing their discounted rewards",
+       default_text(d.n_step)},
+  };
+}
+
+LearnerConfig learner_config_from(const cli::Arguments& args) {
+  LearnerConfig config;
+  config.net.architecture = nets::architecture_from_name(args.text("architecture"));
+  config.net.base_channels = args.has("base-channels") ? static_cast<int>(args.integer("base-channels", 1, 512))
+                                                       : nets::default_base_channels(config.net.architecture);
+  config.hierarchy = voxels::parse_hierarchy(args, 4, 128);  // the networks' smallest and largest grids
+  config.batch = static_cast<int>(args.integer("batch", 1, 100000));
+  config.gamma = args.real("gamma", 0, 1);
+  config.reward_scale = args.real("reward-scale", 1e-9, 1e9);
+  config.tau = args.real("tau", 0, 1);
+  config.learning_rate = args.real("lr", 1e-12, 1e30);  // any positive rate (a test diverges on purpose)
+  config.weight_decay = args.real("weight-decay", 0, 1e3);
+  config.grad_clip_value = args.real("grad-clip-value", 0, 1e12);
+  config.grad_clip_norm = args.real("grad-clip-norm", 0, 1e12);
+  config.q_regularisation = args.real("q-reg", 0, 1e6);
+  config.huber_delta = args.real("huber-delta", 1e-9, 1e9);
+  config.tree_branching = qattention::parse_branching(args, "tree-target", 0);
+  config.tree_target_k = config.tree_branching.k;
+  config.n_step = static_cast<int>(args.integer("n-step", 1, 10));
+  config.validate();
+  config.check_memory(static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE)));
+  return config;
+}
+
+std::vector<cli::OptionSpec> loop_options() {
+  const LoopOptions d;
+  return {
+      {"steps", "N", "gradient steps to reach (0: write the initial networks and exit)", default_text(d.steps)},
+      {"follow", "", "keep reading the inputs as they grow; pace training by --replay-ratio", ""},
+      {"stop-file", "FILE", "with --follow: finish once FILE exists and the allowed steps are done", ""},
+      {"replay-ratio", "R", "with --follow: gradient steps per agent transition", default_text(d.replay_ratio)},
+      {"pretrain", "N", "with --follow: steps allowed before any agent transition, on the demonstrations even below --start-after",
+       default_text(d.pretrain)},
+      {"start-after", "N", "train once the replay holds N transitions (demos included)", default_text(d.start_after)},
+      {"checkpoint-every", "N", "steps between checkpoints", default_text(d.checkpoint_every)},
+      {"metrics", "FILE", "CSV of training figures", ""},
+      {"log-every", "N", "steps between metrics rows and progress lines", default_text(d.log_every)},
+      {"beta", "B", "importance-weight exponent: (N p)^-B over its batch maximum (published: 1/sqrt(p), B = 0.5)",
+       default_text(d.beta)},
+      nets::torch_threads_option(d.threads),
+  };
+}
+
+LoopOptions loop_options_from(const cli::Arguments& args) {
+  LoopOptions loop;
+  loop.steps = args.integer("steps", 0, 1000000000000);
+  loop.start_after = args.integer("start-after", 0, 1000000000000);
+  loop.pretrain = args.integer("pretrain", 0, 1000000000000);
+  loop.replay_ratio = args.real("replay-ratio", 0, 1e6);
+  loop.beta = args.real("beta", 0, 1);
+  loop.follow = args.flag("follow");
+  loop.stop_file = args.text("stop-file");
+  loop.checkpoint_every = args.integer("checkpoint-every", 1, 1000000000000);
+  loop.log_every = args.integer("log-every", 1, 1000000000000);
+  loop.metrics_path = args.text("metrics");
+  loop.seed = args.seed();
+  loop.threads = static_cast<int>(args.integer("threads", 1, 256));
+  return loop;
+}
+
+std::vector<cli::OptionSpec> replay_options() {
+  const replay::ReplayOptions d;
+  return {
+      {"uniform", "", "uniform replay sampling instead of prioritised", ""},
+      {"alpha", "A", "priority exponent", default_text(d.alpha)},
+      {"capacity", "N", "replay capacity in transitions (demos always kept)", default_text(d.capacity)},
+  };
+}
+
+replay::ReplayOptions replay_options_from(const cli::Arguments& args) {
+  replay::ReplayOptions options;
+  options.capacity = static_cast<std::size_t>(args.integer("capacity", 1, 1000000000));
+  options.prioritised = !args.flag("uniform");
+  options.alpha = args.real("alpha", 0, 10);
+  return options;
+}
+
+}  // namespace qte::learner
