@@ -27,7 +27,6 @@ static cli::Usage usage() {
   u.options = {
       {"task", "T", "one of: " + tasks::task_list(), "", false, true},
       {"retries", "N", "new seeds to try for an episode whose expert failed", "0"},
-      {"no-points", "", "leave point clouds out of the recorded observations (the planner still uses them)", ""},
   };
   u.options.push_back(planning::time_budget_option());
   u.options.push_back(cli::output_file());

@@ -1,17 +1,10 @@
 // obs-pack: saved RGB-D camera frames (colour + 16-bit depth PNGs, or .pcd clouds) to 'obs' records.
-#include <sys/stat.h>
-
-#include <cctype>
-#include <cstring>
 #include <iostream>
 
-#include "camera_recordings/camera_recordings.hpp"
-#include "camera_recordings/png_frames.hpp"
+#include "camera_recordings/recording.hpp"
 #include "cli/command.hpp"
-#include "point_clouds/pcd_file.hpp"
 #include "stream/writer.hpp"
 #include "voxels/observation_cloud.hpp"
-#include "world/scene_layout.hpp"
 
 using namespace qte;
 
@@ -60,7 +53,7 @@ static cli::Usage usage() {
       {"joints", "FILE.csv", "robot state per frame: 7 joint angles (rad)[, gripper opening (m)]", ""},
       {"task", "NAME", "the records' task name", "real"},
       {"episode-length", "N", "next-best poses per episode (the networks' time input scales by it)", "10"},
-      {"no-points", "", "do not store <camera>.points (readers rebuild them from depth; plan-path needs them)", ""},
+      voxels::no_points_option(),
   };
   u.options.push_back(cli::output_file());
   u.examples = {
@@ -76,121 +69,47 @@ static cli::Usage usage() {
   return u;
 }
 
-// The pattern with its one integer conversion (%d, %06d, %i, %u with flags and width) filled in;
-// anything else ('%s', two conversions) is refused rather than handed to printf.
-static std::string frame_path(const std::string& pattern, int64_t index) {
-  std::string out;
-  int conversions = 0;
-  for (std::size_t i = 0; i < pattern.size(); ++i) {
-    if (pattern[i] != '%') {
-      out += pattern[i];
-      continue;
-    }
-    if (i + 1 < pattern.size() && pattern[i + 1] == '%') {
-      out += '%';
-      ++i;
-      continue;
-    }
-    std::size_t j = i + 1;
-    while (j < pattern.size() && std::strchr("-+ 0#", pattern[j])) ++j;
-    while (j < pattern.size() && std::isdigit(static_cast<unsigned char>(pattern[j]))) ++j;
-    if (j >= pattern.size() || !std::strchr("diu", pattern[j]) || ++conversions > 1)
-      throw UsageError("file pattern '" + pattern + "': expected exactly one integer conversion such as %06d");
-    char number[64];
-    std::snprintf(number, sizeof number, ("%" + pattern.substr(i + 1, j - i - 1) + "lld").c_str(),
-                  static_cast<long long>(index));
-    out += number;
-    i = j;
-  }
-  if (conversions != 1) throw UsageError("file pattern '" + pattern + "': expected one integer conversion such as %06d");
-  return out;
-}
-
-static bool exists(const std::string& path) {
-  struct stat st;
-  return ::stat(path.c_str(), &st) == 0;
-}
-
 static camera_recordings::CameraSetup camera_setup(const cli::Arguments& args) {
   camera_recordings::CameraSetup camera;
   camera.name = args.text("camera");
   if (!stream::is_valid_field_name(camera.name + ".rgb")) throw UsageError("--camera: not a usable field name");
-  if (args.has("intrinsics")) {
-    const auto k = args.reals("intrinsics", 4);
-    Eigen::Matrix<double, 3, 3, Eigen::RowMajor> m;
-    m << k[0], 0, k[2], 0, k[1], k[3], 0, 0, 1;
-    const std::string problem = voxels::intrinsics_problem(m.data());
-    if (!problem.empty()) throw UsageError("--intrinsics: expected " + problem);
-    camera.intrinsics = m;
-  }
+  if (args.has("intrinsics"))
+    camera.intrinsics = camera_recordings::intrinsics_from_values(args.reals("intrinsics", 4), "intrinsics");
   if (args.has("camera-pose") == args.has("extrinsics")) throw UsageError("give the camera's pose: one of --camera-pose and --extrinsics");
-  if (args.has("camera-pose")) {
-    const auto p = args.reals("camera-pose", 7);
-    const Eigen::Quaterniond q(p[6], p[3], p[4], p[5]);
-    if (std::abs(q.norm() - 1) > 1e-3) throw UsageError("--camera-pose: the quaternion must have unit length");
-    camera.camera_to_world = Eigen::Translation3d(p[0], p[1], p[2]) * q.normalized();
-  } else {
-    const auto e = args.reals("extrinsics", 16);
-    for (int r = 0; r < 4; ++r)
-      for (int c = 0; c < 4; ++c) camera.camera_to_world.matrix()(r, c) = e[4 * r + c];
-    const std::string problem = voxels::extrinsics_problem(e.data());
-    if (!problem.empty()) throw UsageError("--extrinsics: expected " + problem);
-  }
+  camera.camera_to_world = args.has("camera-pose")
+                               ? camera_recordings::camera_pose_from_values(args.reals("camera-pose", 7), "camera-pose")
+                               : camera_recordings::camera_pose_from_matrix(args.reals("extrinsics", 16), "extrinsics");
   camera.depth_unit_m = args.real("depth-unit", 1e-6, 1.0);
   camera.store_points = !args.flag("no-points");
   return camera;
 }
 
 static void run(const cli::Arguments& args) {
+  camera_recordings::Recording recording;
   const bool images = args.has("rgb") || args.has("depth");
   if (images == args.has("pcd")) throw UsageError("give --rgb and --depth, or --pcd");
   if (images && !(args.has("rgb") && args.has("depth"))) throw UsageError("--rgb and --depth go together");
-  const camera_recordings::CameraSetup camera = camera_setup(args);
-  if (images && !camera.intrinsics) throw UsageError("depth images need --intrinsics");
-  const int64_t start = args.integer("start", 0, 1000000000);
-  const int64_t count = args.has("count") ? args.integer("count", 1, 1000000000) : -1;
-  const int episode_length = static_cast<int>(args.integer("episode-length", 1, 1000));
+  recording.rgb_pattern = args.text("rgb");
+  recording.depth_pattern = args.text("depth");
+  recording.pcd_pattern = args.text("pcd");
+  recording.camera = camera_setup(args);
+  if (images && !recording.camera.intrinsics) throw UsageError("depth images need --intrinsics");
+  recording.start = args.integer("start", 0, 1000000000);
+  recording.count = args.has("count") ? args.integer("count", 1, 1000000000) : -1;
+  recording.episode_length = static_cast<int>(args.integer("episode-length", 1, 1000));
+  recording.task = args.text("task");
   const robot::RobotModel robot = robot::RobotModel::xarm7();
-  std::vector<camera_recordings::RobotState> states;
-  if (args.has("joints")) states = camera_recordings::read_joint_csv(args.text("joints"), robot);
+  if (args.has("joints")) {
+    recording.joints_path = args.text("joints");
+    recording.states = camera_recordings::read_joint_csv(recording.joints_path, robot);
+  }
 
   stream::RecordWriter writer(args.text("output"));
-  int64_t written = 0, blind = 0;
-  for (int64_t index = start; count < 0 || written < count; ++index) {
-    const std::string first = frame_path(args.text(images ? "rgb" : "pcd"), index);
-    if (!exists(first)) {
-      if (count >= 0) throw Error(first + ": no such frame (--count " + std::to_string(count) + ")");
-      break;
-    }
-    stream::Record obs("obs");
-    if (images) {
-      const std::string depth_path = frame_path(args.text("depth"), index);
-      const cv::Mat bgr = camera_recordings::read_colour_png(first);
-      const cv::Mat depth = camera_recordings::read_depth_png(depth_path);
-      camera_recordings::add_camera_images(obs, camera, bgr, depth, first + " and " + depth_path);
-    } else {
-      camera_recordings::add_camera_cloud(obs, camera, point_clouds::read_pcd(first));
-    }
-    if (args.has("joints")) {
-      if (written >= static_cast<int64_t>(states.size()))
-        throw Error(args.text("joints") + ": no row for frame " + std::to_string(index) + " (" +
-                    std::to_string(states.size()) + " rows)");
-      camera_recordings::add_robot_state(obs, states[written], robot, world::SceneLayout{}.robot_base_pose());
-    } else {
-      obs.set_scalar<uint8_t>("gripper_open", 1);
-      obs.set_scalar<double>("gripper_opening_m", robot.max_finger_opening_m());
-    }
-    camera_recordings::add_episode_fields(obs, static_cast<int>(written), episode_length, args.text("task"));
-    const voxels::ObservationCloud cloud = voxels::observation_cloud(obs);
-    if (voxels::points_inside(cloud.view(), voxels::GridBounds{}) == 0) blind += 1;
-    writer.write(obs);
-    written += 1;
-  }
-  if (written == 0) throw Error(frame_path(args.text(images ? "rgb" : "pcd"), start) + ": no such frame");
+  const auto packed = camera_recordings::pack_recording(recording, robot, [&](const stream::Record& obs) { writer.write(obs); });
   writer.close();
   // Not an error here (other bounds may suit), but qte-select and qattn-train refuse such frames.
-  if (blind > 0)
-    std::cerr << "obs-pack: warning: " << blind << " of " << written
+  if (packed.blind > 0)
+    std::cerr << "obs-pack: warning: " << packed.blind << " of " << packed.written
               << " frames have no point inside the default scene bounds -0.3,-0.5,0.6,1.0: check the camera pose "
                  "(--camera-pose, --extrinsics), --intrinsics and --depth-unit\n";
 }

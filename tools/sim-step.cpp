@@ -42,7 +42,6 @@ static cli::Usage usage() {
       {"task", "T", "run episodes of task T by itself (--episodes, --variation and --scenes apply to them)", ""},
       {"every-step", "", "also write an observation at every 50 ms control step of a trajectory "
                          "(full demonstrations)", ""},
-      {"no-points", "", "leave the world-frame point clouds out of observations", ""},
       {"threads", "N", "rendering threads", "2"},
       {"chunk-episodes", "N", "with --task: run episodes in chunks of N, chunk c drawn as --seed S + c "
                               "would draw them (an actor that stays up for a whole learning run); needs --gate", "0"},
@@ -72,7 +71,6 @@ static cli::Usage usage() {
 static void run(const cli::Arguments& args) {
   sim_step::SimulatorOptions options = sim_step::parse_camera_options(args);
   options.observe_every_step = args.flag("every-step");
-  options.point_clouds = !args.flag("no-points");
   options.render_threads = static_cast<int>(args.integer("threads", 1, 256));
 
   const robot::RobotModel robot = robot::RobotModel::xarm7();

@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -123,6 +124,18 @@ OptionSpec output_file() { return {"output", "FILE", "where to write; '-' is sta
 bool Arguments::has(const std::string& name) const { return given_.count(name) > 0; }
 
 bool Arguments::flag(const std::string& name) const { return has(name); }
+
+std::vector<std::string> Arguments::list(const std::string& name) const {
+  const std::string v = text(name);
+  std::vector<std::string> items;
+  for (std::size_t at = 0; at <= v.size();) {
+    const std::size_t comma = std::min(v.find(',', at), v.size());
+    items.push_back(v.substr(at, comma - at));
+    if (items.back().empty()) throw UsageError("--" + name + ": expected comma-separated names, got '" + v + "'");
+    at = comma + 1;
+  }
+  return items;
+}
 
 std::vector<std::pair<std::string, std::string>> Arguments::assignments(const std::string& name) const {
   std::vector<std::pair<std::string, std::string>> pairs;

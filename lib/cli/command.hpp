@@ -83,6 +83,8 @@ class Arguments {
   // Exactly `count` comma-separated finite numbers ("0.1,0,0.8"), or a UsageError naming the option.
   std::vector<double> reals(const std::string& name, std::size_t count) const;
   std::vector<std::string> all(const std::string& name) const;  // repeatable options
+  // Comma-separated names ("front,wrist"): at least one, none empty.
+  std::vector<std::string> list(const std::string& name) const;
   // Every NAME=VALUE of a repeatable option, in order (NAME not empty, VALUE may be).
   std::vector<std::pair<std::string, std::string>> assignments(const std::string& name) const;
   const std::vector<std::string>& positional() const { return positional_; }

@@ -76,10 +76,8 @@ Goal goal_from(const stream::Record& action) {
   const auto pose = action.array<double>("pose");
   if (pose.size() != robot::kPoseValues) action.fail("pose", "float64 [7]: x, y, z, qx, qy, qz, qw");
   Goal goal;
-  const Eigen::Quaterniond rotation = robot::quaternion_of(pose.data);
   goal.tcp_pose.translation() << pose[0], pose[1], pose[2];
-  goal.pose_valid = goal.tcp_pose.translation().allFinite() && rotation.coeffs().allFinite() &&
-                    std::abs(rotation.norm() - 1.0) <= 1e-3;
+  goal.pose_valid = robot::pose_values_valid(pose.data);
   if (goal.pose_valid) goal.tcp_pose = robot::pose_from_values(pose.data);
   goal.gripper_open = action.has("gripper_open") ? action.scalar<uint8_t>("gripper_open") != 0 : true;
   goal.ignore_collisions = action.has("ignore_collisions") && action.scalar<uint8_t>("ignore_collisions") != 0;

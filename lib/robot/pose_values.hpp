@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <vector>
 
 namespace qte::robot {
@@ -19,6 +20,13 @@ inline std::vector<double> pose_values(const Eigen::Isometry3d& pose) {
 // The quaternion of 7 values, unnormalized (readers check it before use).
 inline Eigen::Quaterniond quaternion_of(const double* values) {
   return Eigen::Quaterniond(values[6], values[3], values[4], values[5]);
+}
+// True when the 7 values are finite and the quaternion has unit length (within 1e-3): the
+// poses readers accept.
+inline bool pose_values_valid(const double* values) {
+  for (int i = 0; i < kPoseValues; ++i)
+    if (!std::isfinite(values[i])) return false;
+  return std::abs(quaternion_of(values).norm() - 1.0) <= 1e-3;
 }
 // The pose of 7 values whose quaternion is finite and near unit length (normalized here).
 inline Eigen::Isometry3d pose_from_values(const double* values) {

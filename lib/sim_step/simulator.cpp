@@ -31,20 +31,13 @@ std::vector<double> row_major(const Matrix& m) {
 
 }  // namespace
 
-SimulatorOptions options_from_camera_arguments(const std::string& cameras, const std::string& image_size) {
+SimulatorOptions options_for_cameras(const std::vector<std::string>& cameras, int width, int height) {
   render::CameraIntrinsics intrinsics;
-  char x = 0;
-  std::istringstream size(image_size);
-  if (!(size >> intrinsics.width >> x >> intrinsics.height) || x != 'x' || !size.eof() || intrinsics.width < 8 ||
-      intrinsics.height < 8 || intrinsics.width > 4096 || intrinsics.height > 4096)
-    throw UsageError("--image-size: expected WxH between 8x8 and 4096x4096, got '" + image_size + "'");
+  intrinsics.width = width;
+  intrinsics.height = height;
   SimulatorOptions options;
   options.cameras.clear();
-  std::istringstream names(cameras);
-  for (std::string name; std::getline(names, name, ',');) {
-    options.cameras.push_back({name, intrinsics});
-  }
-  if (options.cameras.empty()) throw UsageError("--cameras: name at least one camera");
+  for (const std::string& name : cameras) options.cameras.push_back({name, intrinsics});
   return options;
 }
 

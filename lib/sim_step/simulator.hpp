@@ -47,9 +47,9 @@ struct SimulatorOptions {
 // what tells a grasp that closed on nothing, or a dropped object, from one that holds).
 void set_object_fields(stream::Record& obs, const world::World& world);
 
-// Options for the cameras named in `cameras` ("front,wrist") at resolution `image_size`
-// ("128x128"), as the tools' --cameras and --image-size give them. Throws UsageError.
-SimulatorOptions options_from_camera_arguments(const std::string& cameras, const std::string& image_size);
+// Options for the cameras named in `cameras` ("front", "wrist") at width x height pixels, as the
+// tools' --cameras and --image-size give them (parse_camera_options).
+SimulatorOptions options_for_cameras(const std::vector<std::string>& cameras, int width, int height);
 
 // The camera poses of the scene layout (front: facing the robot across the table).
 Eigen::Isometry3d camera_pose(const std::string& name, const world::World& world);

@@ -1,6 +1,7 @@
 #include "sim_step/simulator_options.hpp"
 
 #include "tasks/task.hpp"
+#include "voxels/observation_cloud.hpp"
 
 namespace qte::sim_step {
 
@@ -9,6 +10,7 @@ std::vector<cli::OptionSpec> camera_options() {
       {"cameras", "LIST", "comma-separated cameras: front, wrist, overhead", "front"},
       {"image-size", "WxH", "camera resolution, e.g. 128x128 or 256x256", "128x128"},
       {"compress", "", "zstd-compress images and point clouds (for files on disk)", ""},
+      voxels::no_points_option(),
       {"objects", "", "also write every task object's name, role (target, distractor, other), pose, bounding box "
                       "and whether the gripper holds it in observations (objects.*: for analyses of where an agent "
                       "went and why it failed; agents never read them)", ""},
@@ -16,7 +18,9 @@ std::vector<cli::OptionSpec> camera_options() {
 }
 
 SimulatorOptions parse_camera_options(const cli::Arguments& args) {
-  SimulatorOptions options = options_from_camera_arguments(args.text("cameras"), args.text("image-size"));
+  const auto [width, height] = args.size("image-size", 8, 8, 4096, 4096);
+  SimulatorOptions options = options_for_cameras(args.list("cameras"), width, height);
+  options.point_clouds = !args.flag("no-points");
   options.compress_images = args.flag("compress");
   options.object_poses = args.flag("objects");
   return options;

@@ -28,8 +28,8 @@ static double median_ms(F&& f, int reps) {
 
 int main() {
   const robot::RobotModel robot = robot::RobotModel::xarm7();
-  for (const char* size : {"128x128", "256x256"}) {
-    sim_step::SimulatorOptions options = sim_step::options_from_camera_arguments("front", size);
+  for (const int side : {128, 256}) {
+    sim_step::SimulatorOptions options = sim_step::options_for_cameras({"front"}, side, side);
     options.render_threads = 1;
     sim_step::Simulator sim(robot, options);
     stream::Record obs("obs");
@@ -37,7 +37,7 @@ int main() {
     const std::size_t points = voxels::observation_cloud(obs).view().count;
     voxels::VoxelsRecordOptions grid;
     const double voxelize = median_ms([&] { (void)voxels::voxels_of(obs, grid); }, 30);
-    std::printf("%s front camera, %zu pixels: voxelize (16^3, no filter) %.2f ms\n", size, points, voxelize);
+    std::printf("%dx%d front camera, %zu pixels: voxelize (16^3, no filter) %.2f ms\n", side, side, points, voxelize);
     point_clouds::CloudFilters crop, outliers, downsample, all;
     crop.crop = all.crop = Eigen::AlignedBox3f(Eigen::Vector3f(-0.3f, -0.5f, 0.6f), Eigen::Vector3f(0.7f, 0.5f, 1.6f));
     outliers.outlier_neighbours = all.outlier_neighbours = 20;

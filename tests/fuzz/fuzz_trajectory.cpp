@@ -7,7 +7,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const qte::robot::RobotModel robot = qte::robot::RobotModel::xarm7();
-  qte::sim_step::SimulatorOptions options = qte::sim_step::options_from_camera_arguments("front", "16x16");
+  qte::sim_step::SimulatorOptions options = qte::sim_step::options_for_cameras({"front"}, 16, 16);
   options.max_trajectory_s = 1.0;
   options.render_threads = 1;
   qte::sim_step::Simulator simulator(robot, options);

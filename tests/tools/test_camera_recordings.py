@@ -150,7 +150,7 @@ cases = [
       "--camera-pose", "0,0,0,0,0,0,1"], 2, "--intrinsics"),
     (["--rgb", p("none_%d.png"), "--depth", p("none_%d.png"), "--intrinsics", "1,1,1,1",
       "--camera-pose", "0,0,0,0,0,0,1"], 1, "no such frame"),
-    (["--pcd", p("pcd/%06d.front.pcd"), "--camera-pose", "0,0,0,0,0,0,2"], 2, "unit length"),
+    (["--pcd", p("pcd/%06d.front.pcd"), "--camera-pose", "0,0,0,0,0,0,2"], 2, "unit quaternion"),
     (["--pcd", p("pcd/%s.front.pcd"), "--camera-pose", "0,0,0,0,0,0,1"], 2, "one integer conversion"),
     (["--pcd", p("pcd/%06d.front.pcd"), "--start", index, "--camera-pose", "0,0,0,0,0,0,1", "--joints", p("deg.csv")],
      1, "degrees"),

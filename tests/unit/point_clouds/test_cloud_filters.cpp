@@ -146,7 +146,7 @@ TEST(CloudFilters, FilteredObservationIsUnorganizedWithoutDepthAndKeepsTheRest) 
   const robot::RobotModel robot = robot::RobotModel::xarm7();
   sim_step::SimulatorOptions options;
   options.render_threads = 1;
-  options = sim_step::options_from_camera_arguments("front", "64x64");
+  options = sim_step::options_for_cameras({"front"}, 64, 64);
   options.render_threads = 1;
   sim_step::Simulator sim(robot, options);
   stream::Record obs("obs");
