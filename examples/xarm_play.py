@@ -7,58 +7,184 @@
 The SDK is not a dependency of the toolkit; install it where the robot is reached from:
     pip install xarm-python-sdk        (https://github.com/xArm-Developer/xArm-Python-SDK)
 
+Each file is checked again before anything moves, as xarm-export checked it: the header, every
+cell a finite number, the gripper a whole number of units in 0..850, times from 0 and increasing,
+at most 60 s, every row within the xArm 7's joint limits and no joint faster than 180 deg/s from
+row to row (1 % slack for the printed decimals); an error names the file and line.
+
 Each file's first row is reached slowly in position mode (set_servo_angle, 20 deg/s), then the
 rows are streamed in servo mode (mode 1, set_servo_angle_j) at the file's own times; the gripper
-is moved (set_gripper_position, waiting) whenever its column changes. Keep a hand on the
-emergency stop: the planner saw only what the camera saw.
+is moved (set_gripper_position, waiting) whenever its column changes. A file of one row is a move
+to that row, reached slowly. Keep a hand on the emergency stop: the planner saw only what the
+camera saw.
+
+This file is the one home for reading and playing the files: examples/xarm_driver.py imports
+read_moves and play from it.
 """
 import argparse
+import math
 import sys
 import time
 
+HEADER = "time_s,j1_deg,j2_deg,j3_deg,j4_deg,j5_deg,j6_deg,j7_deg,gripper"
+COLUMNS = HEADER.split(",")
+# The xArm 7's joint limits in radians, as lib/robot/xarm7.urdf has them from the datasheet
+# (tests/tools/test_drivers.py checks that they agree), and its 180 deg/s joint speed.
+JOINT_LIMITS_RAD = [(-6.283185, 6.283185), (-2.059489, 2.094395), (-6.283185, 6.283185),
+                    (-0.191986, 3.926991), (-6.283185, 6.283185), (-1.692969, 3.141593),
+                    (-6.283185, 6.283185)]
+MAX_JOINT_SPEED_DEG_S = 180.0
+SPEED_SLACK = 1.01          # as xarm-export's own check (robot::JointPathLimits::velocity_slack)
+LIMIT_SLACK_DEG = 1e-4      # the file's 6 decimals of a degree around a limit
+MAX_DURATION_S = 60.0
+GRIPPER_OPEN_UNITS = 850
+REACH_SPEED_DEG_S = 20      # how fast the first row is reached in position mode
+
+
+class MotionFileError(ValueError):
+    """A file that is not a motion the arm may execute; its text names the file and line."""
+
+
+class Stopped(Exception):
+    """play() saw its stop test come true between rows."""
+
 
 def read_moves(path):
-    """(times, joint degrees, gripper units) rows of an xarm-export file; errors name the line."""
+    """(time_s, [7 joint degrees], gripper units) rows of an xarm-export file, checked as the
+    module's docstring says; a MotionFileError names the file and line of the first fault."""
     rows, header_seen = [], False
-    with open(path) as f:
-        for number, line in enumerate(f, 1):
-            line = line.strip()
-            if not line or line.startswith("#"):
-                continue
-            if not header_seen:
-                if line != "time_s,j1_deg,j2_deg,j3_deg,j4_deg,j5_deg,j6_deg,j7_deg,gripper":
-                    sys.exit(f"{path}: line {number}: expected xarm-export's header, got {line!r}")
-                header_seen = True
-                continue
-            cells = line.split(",")
-            if len(cells) != 9:
-                sys.exit(f"{path}: line {number}: expected 9 columns, got {len(cells)}")
-            values = [float(c) for c in cells]
-            rows.append((values[0], values[1:8], int(values[8])))
+
+    def fail(number, what):
+        raise MotionFileError(f"{path}: line {number}: {what}")
+
+    try:
+        with open(path, encoding="utf-8") as f:
+            lines = f.read().split("\n")
+    except (OSError, UnicodeDecodeError) as e:
+        raise MotionFileError(f"{path}: {e.strerror if isinstance(e, OSError) else e}") from None
+    for number, line in enumerate(lines, 1):
+        line = line.strip()
+        if not line or line.startswith("#"):
+            continue
+        if not header_seen:
+            if line != HEADER:
+                fail(number, f"expected xarm-export's header {HEADER!r}, got {line[:100]!r}")
+            header_seen = True
+            continue
+        cells = line.split(",")
+        if len(cells) != len(COLUMNS):
+            fail(number, f"expected {len(COLUMNS)} columns, got {len(cells)}")
+        values = []
+        for column, cell in zip(COLUMNS, cells):
+            try:
+                value = float(cell)
+            except ValueError:
+                fail(number, f"{column}: {cell[:40]!r} is not a number")
+            if not math.isfinite(value):
+                fail(number, f"{column}: {cell!r} is not a finite number")
+            values.append(value)
+        t, joints, gripper = values[0], values[1:8], values[8]
+        if gripper != int(gripper) or not 0 <= gripper <= GRIPPER_OPEN_UNITS:
+            fail(number, f"gripper: {cells[8]!r} is not a whole number of units in 0..{GRIPPER_OPEN_UNITS}")
+        if not rows and t != 0:
+            fail(number, f"time_s: the first row's time is {cells[0]}, not 0")
+        if rows and t <= rows[-1][0]:
+            fail(number, f"time_s: {cells[0]} does not increase (the row before is at {rows[-1][0]:g} s)")
+        if t > MAX_DURATION_S:
+            fail(number, f"time_s: {cells[0]} s, longer than {MAX_DURATION_S:g} s")
+        for k, (q, (low, high)) in enumerate(zip(joints, JOINT_LIMITS_RAD)):
+            if not math.degrees(low) - LIMIT_SLACK_DEG <= q <= math.degrees(high) + LIMIT_SLACK_DEG:
+                fail(number, f"j{k + 1}_deg: {cells[k + 1]} outside the joint's limits "
+                             f"[{math.degrees(low):.3f}, {math.degrees(high):.3f}]")
+            if rows:
+                speed = abs(q - rows[-1][1][k]) / (t - rows[-1][0])
+                if speed > MAX_JOINT_SPEED_DEG_S * SPEED_SLACK:
+                    fail(number, f"j{k + 1}_deg: {speed:.1f} deg/s from the row before, faster than "
+                                 f"{MAX_JOINT_SPEED_DEG_S:g} deg/s")
+        rows.append((t, joints, int(gripper)))
+    if not header_seen:
+        raise MotionFileError(f"{path}: no header (expected {HEADER!r})")
     if not rows:
-        sys.exit(f"{path}: no rows")
+        raise MotionFileError(f"{path}: no rows")
     return rows
 
 
-def play(arm, rows):
+def describe(rows):
+    """One line: rows, duration, start and end joints, gripper."""
+    joints = lambda q: "(" + ",".join(f"{v:.1f}" for v in q) + ")"  # noqa: E731
+    return (f"{len(rows)} rows over {rows[-1][0]:.2f} s, joints {joints(rows[0][1])} -> {joints(rows[-1][1])} deg, "
+            f"gripper {rows[0][2]} -> {rows[-1][2]}")
+
+
+# The SDK's return codes (doc/api/xarm_api_code.md of the SDK), for faults in words.
+API_CODES = {-9: "emergency stop", -8: "out of range", -7: "joint angle limit", -6: "cartesian position limit",
+             -2: "the arm is not ready (motion not enabled or state not set)", -1: "the arm is not connected",
+             1: "the controller has an error", 2: "the controller has a warning", 3: "no response in time",
+             8: "the command could not be sent (network?)"}
+
+
+class ArmFault(Exception):
+    """An SDK call failed; the text says which and why, in words."""
+
+
+def check(arm, code, call):
+    """SDK calls answer a code, 0 for success; anything else stops the motion with the
+    controller's error or warning, in words."""
+    if code != 0:
+        raise ArmFault(f"{call} returned {code} ({API_CODES.get(code, 'see the SDK code list')}); {controller_state(arm)}")
+
+
+def controller_state(arm):
+    """The controller's error and warning codes in words (the SDK's own descriptions)."""
+    try:
+        arm.get_err_warn_code()
+    except Exception:  # noqa: BLE001 - the codes below are the last ones the arm reported
+        pass
+    error, warn = getattr(arm, "error_code", 0) or 0, getattr(arm, "warn_code", 0) or 0
+    if not error and not warn:
+        return "no controller error"
+    try:
+        from xarm.core.config.x_code import ControllerError, ControllerWarn
+    except ImportError:
+        ControllerError = ControllerWarn = None
+    words = []
+    for code, kind, describe_code in ((error, "error", ControllerError), (warn, "warning", ControllerWarn)):
+        if code:
+            text = describe_code(code).description if describe_code else None
+            if isinstance(text, dict):  # {'en': ..., 'cn': ...} in the SDK's newer versions
+                text = text.get("en")
+            words.append(f"{text or 'controller ' + kind}, {kind} code {code}")
+    return "; ".join(words)
+
+
+def play(arm, rows, stopped=lambda: False, pace=1.0):
+    """Executes checked rows on an XArmAPI (or anything with its methods). stopped() is asked
+    before the motion and between streamed rows; when it is true, Stopped is raised and the
+    caller stops the arm. pace scales the rows' times (0: no waiting, for a dry run's stand-in)."""
     _, first, gripper = rows[0]
+    if stopped():
+        raise Stopped()
     arm.set_mode(0)  # position mode: reach the first row slowly
     arm.set_state(0)
-    arm.set_servo_angle(angle=first, speed=20, is_radian=False, wait=True)
-    arm.set_gripper_position(gripper, wait=True)
+    check(arm, arm.set_servo_angle(angle=first, speed=REACH_SPEED_DEG_S, is_radian=False, wait=True), "set_servo_angle")
+    check(arm, arm.set_gripper_position(gripper, wait=True), "set_gripper_position")
+    if len(rows) == 1:
+        return
     arm.set_mode(1)  # servo mode: stream the rows
     arm.set_state(0)
-    time.sleep(0.1)
+    time.sleep(0.1 * pace)
     start = time.monotonic()
     for t, angles, g in rows:
-        delay = start + t - time.monotonic()
+        if stopped():
+            raise Stopped()
+        delay = start + t * pace - time.monotonic()
         if delay > 0:
             time.sleep(delay)
         if g != gripper:
-            arm.set_gripper_position(g, wait=True)
+            check(arm, arm.set_gripper_position(g, wait=True), "set_gripper_position")
             gripper = g
-            start = time.monotonic() - t  # the gripper's wait shifts the remaining rows
-        arm.set_servo_angle_j(angles=angles, is_radian=False)
+            start = time.monotonic() - t * pace  # the gripper's wait shifts the remaining rows
+        check(arm, arm.set_servo_angle_j(angles=angles, is_radian=False), "set_servo_angle_j")
 
 
 def main():
@@ -67,10 +193,13 @@ def main():
     parser.add_argument("--ip", help="the xArm controller's address")
     parser.add_argument("--dry-run", action="store_true", help="read and check the files, move nothing")
     args = parser.parse_args()
-    moves = [(path, read_moves(path)) for path in args.files]
+    try:
+        moves = [(path, read_moves(path)) for path in args.files]
+    except MotionFileError as e:
+        sys.exit(str(e))
     if args.dry_run:
         for path, rows in moves:
-            print(f"{path}: {len(rows)} rows over {rows[-1][0]:.2f} s, gripper {rows[0][2]} -> {rows[-1][2]}")
+            print(f"{path}: {describe(rows)}")
         return
     if not args.ip:
         sys.exit("--ip is required (or --dry-run)")
@@ -82,7 +211,10 @@ def main():
     try:
         for path, rows in moves:
             print(f"playing {path}", file=sys.stderr)
-            play(arm, rows)
+            try:
+                play(arm, rows)
+            except ArmFault as e:
+                sys.exit(f"{path}: {e}")
     finally:
         arm.set_mode(0)
         arm.set_state(0)
