@@ -1,11 +1,7 @@
 // sim-step: the simulator as a filter: reset and trajectory records in, observations out.
-#include <unistd.h>
-
 #include "cli/command.hpp"
 #include "sim_step/simulator.hpp"
 #include "sim_step/simulator_options.hpp"
-#include "stream/reader.hpp"
-#include "stream/writer.hpp"
 #include "tasks/task.hpp"
 
 using namespace qte;
@@ -43,14 +39,9 @@ static cli::Usage usage() {
       {"every-step", "", "also write an observation at every 50 ms control step of a trajectory "
                          "(full demonstrations)", ""},
       {"threads", "N", "rendering threads", "2"},
-      {"chunk-episodes", "N", "with --task: run episodes in chunks of N, chunk c drawn as --seed S + c "
-                              "would draw them (an actor that stays up for a whole learning run); needs --gate", "0"},
-      {"first-chunk", "C", "the first chunk this process runs", "0"},
-      {"chunk-stride", "S", "the chunks this process runs: C, C + S, C + 2S, ...", "1"},
-      {"gate", "DIR", "chunk c starts once DIR/cccc.go exists (c with at least four digits); none starts "
-                      "once DIR/stop exists; DIR/cccc.steps gets the environment steps of chunk c when it ends", ""},
   };
   u.options.push_back(cli::output_file());
+  u.add_options(sim_step::chunk_options());
   u.add_options(sim_step::episode_options(1, sim_step::SceneSet::any));
   u.add_options(sim_step::camera_options());
   u.uses_randomness = true;
@@ -77,39 +68,7 @@ static void run(const cli::Arguments& args) {
   sim_step::Simulator simulator(robot, options);
   std::optional<sim_step::EpisodePlan> plan;
   if (args.has("task")) plan = sim_step::parse_episode_plan(args, args.text("task"));
-  const std::string input = args.input();
-  std::unique_ptr<stream::RecordReader> reader;
-  stream::RecordWriter writer(args.text("output"));
-  const int chunk_episodes = static_cast<int>(args.integer("chunk-episodes", 0, 10000000));
-  if (chunk_episodes > 0 && (!plan || args.text("gate").empty()))
-    throw UsageError("--chunk-episodes needs --task and --gate");
-  sim_step::DirectoryGate gate(args.text("gate"));
-  sim_step::SimStep stage = chunk_episodes > 0
-                                ? sim_step::SimStep(simulator, *plan,
-                                                    {chunk_episodes, static_cast<int>(args.integer("first-chunk", 0, 100000000)),
-                                                     static_cast<int>(args.integer("chunk-stride", 1, 1000000))},
-                                                    gate)
-                                : sim_step::SimStep(simulator, plan);
-  stream::run_stage(
-      stage,
-      [&]() -> std::optional<stream::Record> {
-        // Opened on demand: opening a FIFO blocks until its writer appears, and in the actor
-        // loop that writer waits for our first observation.
-        if (!reader) reader = std::make_unique<stream::RecordReader>(input);
-        return reader->next();
-      },
-      [&](const stream::Record& obs) { writer.write(obs); });
-  writer.close();
-  if (!plan) return;
-  // The last episode is over, but in a FIFO loop its last records are still on their way
-  // back to us. Closing standard output lets the programs downstream see the end of the
-  // stream, finish and close the FIFO; reading our input to its end meanwhile spares them
-  // a broken pipe (exit 141) on the records they still pass on.
-  if (args.text("output") == "-") ::close(STDOUT_FILENO);
-  if (input == "-" && ::isatty(STDIN_FILENO)) return;
-  if (!reader) reader = std::make_unique<stream::RecordReader>(input);
-  while (reader->next()) {
-  }
+  sim_step::run_episodes(args, simulator, plan);
 }
 
 int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }

@@ -47,7 +47,20 @@ void remove_staging_directory_in_handler(const char* path) {
   ::rmdir(path);
 }
 
+// The file write_on_fatal_signal() asked for, written first.
+char g_note_path[4096];
+char g_note_text[256];
+volatile sig_atomic_t g_note_set = 0;
+
 void remove_temp_files_and_die(int signal_number) {
+  if (g_note_set) {
+    const int fd = ::open(g_note_path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd >= 0) {
+      const ssize_t ignored = ::write(fd, g_note_text, std::strlen(g_note_text));
+      (void)ignored;
+      ::close(fd);
+    }
+  }
   for (int kind : {kFile, kStagingDirectory, kCreatedDirectory})  // a directory empties before it goes
     for (int i = 0; i < kMaxTempFiles; ++i) {
       if (g_temp_kind[i] != kind) continue;
@@ -79,6 +92,20 @@ int register_temp(const std::string& path, TempKind kind = kFile) {
     }
   return -1;  // still correct, only not cleaned up on a signal
 }
+
+}  // namespace
+
+void write_on_fatal_signal(const std::string& path, const std::string& text) {
+  if (path.size() >= sizeof g_note_path || text.size() >= sizeof g_note_text)
+    throw Error(path + ": too long a name for a file written on a signal");
+  std::call_once(g_handlers_installed, install_handlers);
+  g_note_set = 0;
+  std::memcpy(g_note_path, path.c_str(), path.size() + 1);
+  std::memcpy(g_note_text, text.c_str(), text.size() + 1);
+  g_note_set = 1;
+}
+
+namespace {
 
 void unregister_temp(const std::string& path) {
   std::lock_guard<std::mutex> lock(g_mutex);

@@ -71,6 +71,11 @@ class OutputDirectory {
   bool created_dir_ = false, committed_ = false;
 };
 
+// A file to write (created or truncated, holding `text`) when SIGINT, SIGTERM or SIGHUP ends the
+// process, before its temporary files are removed: robot-step's spool `stop`, so that the arm
+// halts when the program driving it is interrupted. One such file per process; the last call wins.
+void write_on_fatal_signal(const std::string& path, const std::string& text);
+
 // Convenience: the whole file at once, atomically.
 void write_file_atomically(const std::string& path, const void* data, std::size_t n);
 

@@ -24,6 +24,8 @@ std::vector<XarmRow> xarm_rows(const double* time_s, const double* joints, int64
   for (int64_t i = 0; i <= ticks; ++i) {
     const double t = std::min(duration, static_cast<double>(i) / rate_hz);
     if (!times.empty() && t <= times.back()) break;
+    // A tick a hair before the end would print with the end's time: the end stands for both.
+    if (i < ticks && duration - t < 1e-4) continue;
     const JointVector q = joint_path_at(time_s, joints, n, t);
     times.push_back(t);
     sampled.insert(sampled.end(), q.data(), q.data() + kArmJoints);
@@ -51,7 +53,7 @@ std::string xarm_csv(const std::vector<XarmRow>& rows, const std::string& commen
   std::string out = comment + "time_s,j1_deg,j2_deg,j3_deg,j4_deg,j5_deg,j6_deg,j7_deg,gripper\n";
   char line[512];
   for (const XarmRow& r : rows) {
-    int used = std::snprintf(line, sizeof line, "%.4f", r.time_s);
+    int used = std::snprintf(line, sizeof line, "%.6f", r.time_s);
     for (int k = 0; k < kArmJoints; ++k) used += std::snprintf(line + used, sizeof line - used, ",%.6f", r.degrees[k]);
     std::snprintf(line + used, sizeof line - used, ",%d\n", r.gripper);
     out += line;

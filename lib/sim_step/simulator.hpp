@@ -55,7 +55,15 @@ SimulatorOptions options_for_cameras(const std::vector<std::string>& cameras, in
 Eigen::Isometry3d camera_pose(const std::string& name, const world::World& world);
 std::vector<std::string> camera_names();
 
-class Simulator : public stream::Stage {
+// A stage that runs episodes one after another, what SimStep drives: the simulator, or the
+// real robot behind robot-step (lib/robot_step).
+class EpisodeStage : public stream::Stage {
+ public:
+  virtual bool episode_over() const = 0;
+  virtual int steps() const = 0;  // next-best poses executed in the current episode
+};
+
+class Simulator : public EpisodeStage {
  public:
   Simulator(const robot::RobotModel& robot, SimulatorOptions options);
   ~Simulator() override;
@@ -65,8 +73,8 @@ class Simulator : public stream::Stage {
   // or after the episode ended) throw StreamError naming the record.
   void handle(const stream::Record& record, const stream::Emit& emit) override;
 
-  bool episode_over() const { return terminal_; }
-  int steps() const { return step_; }  // next-best poses executed in the current episode
+  bool episode_over() const override { return terminal_; }
+  int steps() const override { return step_; }
 
   // For tests and tools that drive the world directly.
   world::World* world() { return world_.get(); }
@@ -151,15 +159,15 @@ struct EpisodePlan {
 // and index).
 stream::Record plan_reset(const EpisodePlan& plan, int index);
 
-// The sim-step stage: the simulator driven by the records it reads and, with a plan, by
-// itself: its first episode starts before any input (in the actor loop the input is made from
+// The sim-step stage: the simulator (or another EpisodeStage) driven by the records it reads
+// and, with a plan, by itself: its first episode starts before any input (in the actor loop the input is made from
 // that first observation), the next one after each terminal observation, and the stage is
 // done after plan.episodes.
 class SimStep : public stream::Stage {
  public:
-  SimStep(Simulator& simulator, std::optional<EpisodePlan> plan) : simulator_(simulator), plan_(std::move(plan)) {}
+  SimStep(EpisodeStage& simulator, std::optional<EpisodePlan> plan) : simulator_(simulator), plan_(std::move(plan)) {}
   // In chunks: `gate` opens each chunk and hears of its end (it must outlive the stage).
-  SimStep(Simulator& simulator, EpisodePlan plan, ChunkPlan chunks, ChunkGate& gate)
+  SimStep(EpisodeStage& simulator, EpisodePlan plan, ChunkPlan chunks, ChunkGate& gate)
       : simulator_(simulator), plan_(std::move(plan)), chunks_(chunks), gate_(&gate) {}
   void start(const stream::Emit& emit) override;
   void handle(const stream::Record& record, const stream::Emit& emit) override;
@@ -170,7 +178,7 @@ class SimStep : public stream::Stage {
  private:
   void start_episodes_due(const stream::Emit& emit);
   void count_ended_episode();
-  Simulator& simulator_;
+  EpisodeStage& simulator_;
   std::optional<EpisodePlan> plan_;
   std::optional<ChunkPlan> chunks_;
   ChunkGate* gate_ = nullptr;

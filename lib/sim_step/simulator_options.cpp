@@ -1,5 +1,11 @@
 #include "sim_step/simulator_options.hpp"
 
+#include <unistd.h>
+
+#include <memory>
+
+#include "stream/reader.hpp"
+#include "stream/writer.hpp"
 #include "tasks/task.hpp"
 #include "voxels/observation_cloud.hpp"
 
@@ -44,6 +50,53 @@ EpisodePlan parse_episode_plan(const cli::Arguments& args, const std::string& ta
   plan.seed = args.seed();
   plan.scenes = scene_set_from_name(args.text("scenes"));
   return plan;
+}
+
+std::vector<cli::OptionSpec> chunk_options() {
+  return {
+      {"chunk-episodes", "N", "with --task: run episodes in chunks of N, chunk c drawn as --seed S + c "
+                              "would draw them (an actor that stays up for a whole learning run); needs --gate", "0"},
+      {"first-chunk", "C", "the first chunk this process runs", "0"},
+      {"chunk-stride", "S", "the chunks this process runs: C, C + S, C + 2S, ...", "1"},
+      {"gate", "DIR", "chunk c starts once DIR/cccc.go exists (c with at least four digits); none starts "
+                      "once DIR/stop exists; DIR/cccc.steps gets the environment steps of chunk c when it ends", ""},
+  };
+}
+
+void run_episodes(const cli::Arguments& args, EpisodeStage& env, std::optional<EpisodePlan> plan) {
+  const std::string input = args.input();
+  std::unique_ptr<stream::RecordReader> reader;
+  stream::RecordWriter writer(args.text("output"));
+  const int chunk_episodes = static_cast<int>(args.integer("chunk-episodes", 0, 10000000));
+  if (chunk_episodes > 0 && (!plan || args.text("gate").empty()))
+    throw UsageError("--chunk-episodes needs --task and --gate");
+  DirectoryGate gate(args.text("gate"));
+  SimStep stage = chunk_episodes > 0
+                      ? SimStep(env, *plan,
+                                {chunk_episodes, static_cast<int>(args.integer("first-chunk", 0, 100000000)),
+                                 static_cast<int>(args.integer("chunk-stride", 1, 1000000))},
+                                gate)
+                      : SimStep(env, plan);
+  stream::run_stage(
+      stage,
+      [&]() -> std::optional<stream::Record> {
+        // Opened on demand: opening a FIFO blocks until its writer appears, and in the actor
+        // loop that writer waits for our first observation.
+        if (!reader) reader = std::make_unique<stream::RecordReader>(input);
+        return reader->next();
+      },
+      [&](const stream::Record& obs) { writer.write(obs); });
+  writer.close();
+  if (!plan) return;
+  // The last episode is over, but in a FIFO loop its last records are still on their way
+  // back to us. Closing standard output lets the programs downstream see the end of the
+  // stream, finish and close the FIFO; reading our input to its end meanwhile spares them
+  // a broken pipe (exit 141) on the records they still pass on.
+  if (args.text("output") == "-") ::close(STDOUT_FILENO);
+  if (input == "-" && ::isatty(STDIN_FILENO)) return;
+  if (!reader) reader = std::make_unique<stream::RecordReader>(input);
+  while (reader->next()) {
+  }
 }
 
 }  // namespace qte::sim_step

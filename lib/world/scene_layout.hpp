@@ -14,6 +14,14 @@ struct SceneLayout {
   Eigen::Vector2d table_extent_m{1.2, 1.4};
   Eigen::Vector3d robot_base{-0.3, 0.0, kTableHeight_m};
 
+  // The arm's joints (rad) at the start of every episode: the gripper above the table,
+  // pointing down (the fingers open).
+  static Eigen::Matrix<double, 7, 1> ready_joints() {
+    Eigen::Matrix<double, 7, 1> q;
+    q << 0, -0.35, 0, 0.75, 0, 1.1, 0;
+    return q;
+  }
+
   Eigen::Isometry3d robot_base_pose() const {  // facing +x, on the table
     Eigen::Isometry3d base = Eigen::Isometry3d::Identity();
     base.translation() = robot_base;

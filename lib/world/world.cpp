@@ -174,10 +174,7 @@ World::World(const robot::RobotModel& robot, const SceneLayout& layout)
   }
   impl_->checked_link_pairs = robot.self_collision_pairs();
 
-  // Ready pose: the gripper above the table, pointing down, open.
-  robot::JointVector ready;
-  ready << 0, -0.35, 0, 0.75, 0, 1.1, 0;
-  set_robot_state(ready, robot.max_finger_opening_m());
+  set_robot_state(SceneLayout::ready_joints(), robot.max_finger_opening_m());
 }
 
 World::~World() = default;

@@ -1,0 +1,200 @@
+#include "robot_step/robot_world.hpp"
+
+#include <cmath>
+#include <ostream>
+
+#include "camera_recordings/png_frames.hpp"
+#include "common/error.hpp"
+#include "robot/joint_path.hpp"
+#include "tasks/task.hpp"
+#include "world/scene_layout.hpp"
+
+namespace qte::robot_step {
+
+namespace {
+
+constexpr double kStartTolerance_rad = 1e-3;  // a motion must start where the arm is (sim-step's)
+
+std::string degrees_text(const robot::JointVector& degrees) {
+  std::string out;
+  char number[32];
+  for (int k = 0; k < robot::kArmJoints; ++k) {
+    std::snprintf(number, sizeof number, "%s%.1f", k ? "," : "", degrees[k]);
+    out += number;
+  }
+  return out;
+}
+
+}  // namespace
+
+double time_stretch(const double* time_s, const double* joints, int64_t n, const robot::RobotModel& robot,
+                    double fraction) {
+  const robot::JointVector limit = robot.max_velocities() * fraction;
+  double stretch = 1.0;
+  for (int64_t i = 1; i < n; ++i) {
+    const double dt = time_s[i] - time_s[i - 1];
+    for (int k = 0; k < robot::kArmJoints; ++k) {
+      const double distance = std::abs(joints[i * 7 + k] - joints[(i - 1) * 7 + k]);
+      if (dt > 0) stretch = std::max(stretch, distance / (dt * limit[k]));
+    }
+  }
+  return stretch;
+}
+
+RobotWorld::RobotWorld(const robot::RobotModel& robot, RobotOptions options, Spool& spool, Judge& judge)
+    : robot_(robot),
+      options_(std::move(options)),
+      spool_(spool),
+      judge_(judge),
+      world_from_base_(world::SceneLayout().robot_base_pose()) {
+  const std::string home = robot::joint_path_failure(std::vector<double>{0.0}.data(), options_.home.data(), 1, robot_);
+  if (!home.empty()) throw UsageError("--home: " + home);
+  gripper_m_ = robot_.max_finger_opening_m();
+}
+
+void RobotWorld::handle(const stream::Record& record, const stream::Emit& emit) {
+  if (record.type() == "reset") reset(record, emit);
+  else if (record.type() == "trajectory") execute(record, emit);
+}
+
+std::string RobotWorld::send(const std::vector<robot::XarmRow>& rows, const std::string& what) {
+  const robot::XarmRow& last = rows.back();
+  if (options_.log)
+    *options_.log << "robot-step: " << (options_.dry_run ? "dry run, not sent: " : "") << what << ", " << rows.size()
+                  << " rows, " << last.time_s << " s, to " << degrees_text(last.degrees) << " deg, gripper "
+                  << last.gripper << std::endl;
+  robot::JointVector reached = last.degrees;
+  int gripper = last.gripper;
+  last_motion_.clear();
+  if (!options_.dry_run) {
+    const std::string comment = "# robot-step: " + what + "\n";
+    const MotionAnswer answer = spool_.move(rows, comment);
+    last_motion_ = spool_.last_request();
+    if (!answer.done) return answer.fault;
+    reached = answer.degrees, gripper = answer.gripper;
+  }
+  joints_ = reached * (M_PI / 180.0);
+  gripper_m_ = gripper / robot::kXarmGripperOpenUnits * robot_.max_finger_opening_m();
+  return "";
+}
+
+stream::Record RobotWorld::observe() {
+  const CaptureAnswer frame = spool_.capture();
+  if (!frame.fault.empty()) throw Error("the camera recorder on " + spool_.directory() + ": " + frame.fault);
+  stream::Record obs("obs");
+  camera_recordings::add_camera_images(obs, options_.camera, camera_recordings::read_colour_png(frame.colour_png),
+                                       camera_recordings::read_depth_png(frame.depth_png),
+                                       frame.colour_png + " and " + frame.depth_png);
+  if (options_.compress)
+    for (const char* name : {".rgb", ".depth_mm", ".depth", ".points"})
+      if (const stream::Field* f = obs.find(options_.camera.name + name)) {
+        stream::Field compressed = *f;
+        compressed.compress = true;
+        obs.remove(options_.camera.name + name);
+        obs.add(std::move(compressed));
+      }
+  camera_recordings::RobotState state;  // at rest: a motion has ended before each frame
+  state.joints = joints_;
+  state.gripper_opening_m = gripper_m_;
+  camera_recordings::add_robot_state(obs, state, robot_, world_from_base_);
+  last_frame_ = frame.colour_png;
+  return obs;
+}
+
+void RobotWorld::set_episode_fields(stream::Record& obs, const std::string& failure) {
+  camera_recordings::add_episode_fields(obs, step_, options_.episode_length, episode_.task);
+  obs.set_scalar<int32_t>("frame", frame_++);
+  obs.set_scalar<double>("time_s", time_s_);
+  obs.set_scalar<float>("reward", success_ ? tasks::kSuccessReward : 0.0f);
+  obs.set_scalar<uint8_t>("terminal", terminal_);
+  obs.set_scalar<uint8_t>("success", success_);
+  obs.set_scalar<int32_t>("variation", episode_.variation);
+  obs.set_scalar<int64_t>("episode_seed", episode_.seed);
+  obs.set_scalar<uint8_t>("ignore_collisions", ignore_collisions_);
+  if (!failure.empty()) obs.set_string("failure", failure);
+}
+
+void RobotWorld::reset(const stream::Record& record, const stream::Emit& emit) {
+  episode_.task = record.has("task") ? record.string("task") : "real";
+  episode_.variation = record.has("variation") ? record.scalar<int32_t>("variation") : 0;
+  episode_.seed = record.has("seed") ? record.scalar<int64_t>("seed") : 0;
+  episode_.episode = episodes_++;
+  judge_.reset(episode_);
+  // The start pose, reached slowly by the driver (a motion of one row), the gripper open.
+  robot::XarmRow home;
+  home.degrees = options_.home * (180.0 / M_PI);
+  home.gripper = static_cast<int>(robot::kXarmGripperOpenUnits);
+  const std::string fault = send({home}, episode_.task + " episode " + std::to_string(episode_.episode) + ": start pose");
+  if (!fault.empty()) throw Error("the arm driver could not reach the start pose: " + fault);
+  step_ = frame_ = 0;
+  time_s_ = 0;
+  terminal_ = success_ = ignore_collisions_ = false;
+  started_ = true;
+  stream::Record obs = observe();
+  set_episode_fields(obs, "");
+  emit(obs);
+}
+
+std::string RobotWorld::check_motion(const stream::Record& record, std::vector<robot::XarmRow>& rows) const {
+  if (record.has("failure")) return record.string("failure");  // the planner found no path
+  const auto times = record.array<double>("time_s");
+  const auto joints = record.array<double>("joint_positions");
+  const int64_t n = times.size();
+  if (n < 1 || joints.shape != stream::Shape{n, robot::kArmJoints})
+    record.fail("joint_positions", "float64 [N, 7] with N = " + std::to_string(n) +
+                                       " (the length of time_s), got " + stream::shape_to_string(joints.shape));
+  robot::JointPathLimits limits;
+  limits.start = &joints_;
+  limits.start_tolerance_rad = kStartTolerance_rad;
+  std::string failure = robot::joint_path_failure(times.data, joints.data, n, robot_, limits);
+  if (!failure.empty()) return failure;
+  std::vector<double> stretched(times.data, times.data + n);
+  const double stretch = time_stretch(times.data, joints.data, n, robot_, options_.speed_fraction);
+  for (double& t : stretched) t *= stretch;
+  const double after_m = !record.has("gripper_open") ? gripper_m_
+                         : record.scalar<uint8_t>("gripper_open") ? robot_.max_finger_opening_m()
+                                                                  : 0.0;
+  try {
+    rows = robot::xarm_rows(stretched.data(), joints.data, n, gripper_m_, after_m, robot_, options_.rate_hz,
+                            options_.settle_s);
+  } catch (const Error& e) {
+    return std::string("invalid_trajectory:") + e.what();
+  }
+  for (const robot::XarmRow& row : rows) {
+    const Eigen::Vector3d p = (world_from_base_ * robot_.tcp_pose(row.degrees * (M_PI / 180.0))).translation();
+    if (!options_.workspace.contains(p)) {
+      char where[160];
+      std::snprintf(where, sizeof where, "workspace:gripper at (%.3f, %.3f, %.3f) at %.2f s", p.x(), p.y(), p.z(),
+                    row.time_s);
+      return where;
+    }
+  }
+  return "";
+}
+
+void RobotWorld::execute(const stream::Record& record, const stream::Emit& emit) {
+  if (!started_) throw StreamError(record.position, "trajectory before any reset: expected a reset record first");
+  if (terminal_) throw StreamError(record.position, "trajectory after the episode ended: expected a reset record");
+  step_ += 1;
+  ignore_collisions_ = record.has("ignore_collisions") && record.scalar<uint8_t>("ignore_collisions") != 0;
+  std::vector<robot::XarmRow> rows;
+  std::string failure = check_motion(record, rows);
+  if (failure.empty()) {
+    const std::string fault =
+        send(rows, episode_.task + " episode " + std::to_string(episode_.episode) + " step " + std::to_string(step_));
+    if (!fault.empty()) failure = "driver_fault:" + fault;
+    time_s_ += rows.back().time_s;
+  }
+  stream::Record obs = observe();
+  if (failure.empty()) {
+    const Verdict verdict =
+        judge_.judge({episode_, step_, options_.episode_length, last_motion_, last_frame_});
+    success_ = verdict.outcome == Outcome::success;
+    if (verdict.outcome == Outcome::failure) failure = verdict.reason;
+  }
+  terminal_ = success_ || !failure.empty() || step_ >= options_.episode_length;
+  set_episode_fields(obs, failure);
+  emit(obs);
+}
+
+}  // namespace qte::robot_step
