@@ -3,6 +3,7 @@
 
 #include "camera_recordings/recording.hpp"
 #include "cli/command.hpp"
+#include "stream/stream_options.hpp"
 #include "stream/writer.hpp"
 #include "voxels/observation_cloud.hpp"
 
@@ -31,41 +32,66 @@ static cli::Usage usage() {
       "m); the gripper pose follows by forward kinematics. Without it the records carry no joint "
       "state and plan-path refuses them; qte-select needs only the gripper opening (open). "
       "Records are written whole or not at all; a bad file stops with one line naming it.",
+      "A tele-operated or kinesthetic demonstration gives --joint-log instead of --joints: the arm "
+      "driver's log, one row per time stamp: time (s), 7 joint angles (rad), the gripper opening "
+      "(m) and optionally 1 (gripper open) or 0 (closed); without that column a gripper more than "
+      "half open is open, which a gripper closed on a wide object may be. --frame-times gives each "
+      "frame's time on the log's clock, one row per frame from --start; the frames packed are the "
+      "ones it times. A frame's joints and opening are the log's interpolated linearly, its joint "
+      "velocities the slope of the log over the row interval leading to the frame, its gripper "
+      "state the last row's at or before it.",
+      "With --success 1 (or 0) the recording is one whole demonstration, as demo-record writes "
+      "one: frames numbered from 0, steps counted as demo-record counts motions (0, then 1 + the "
+      "keyframes before the frame), the last frame terminal with the success given (reward 100 "
+      "on success). keyframe takes it as it is; it finds the key poses where the gripper acts and "
+      "where the arm stands still (every joint within 0.1 rad/s), so the log must be faster than "
+      "the camera or the arm pause at each key pose. Several demonstrations go into one file with "
+      "--append, which reads every frame once before the first record is appended, so that a bad "
+      "frame leaves the file as it was.",
       "Files are checked before they are decoded. PNGs: at most 32768 pixels on a side and 50 "
       "million in all; the colour PNG of any colour type (reduced to 8-bit RGB), the depth PNG "
       "16-bit greyscale. .pcd files (DATA ascii, binary or binary_compressed): x, y, z 4-byte "
       "floats (TYPE F SIZE 4 COUNT 1), rgb or rgba 4 packed bytes (TYPE F or U), WIDTH x HEIGHT "
       "equal to POINTS (at most 50 million), and the file as long as the header says: ASCII "
       "data exactly POINTS lines of one number per value, each of its field's type. The joint "
-      "CSV: every cell a finite number (a row of nan is refused, not taken for a header).",
+      "CSV, joint log and frame times: every cell a finite number (a row of nan is refused, not "
+      "taken for a header); times increasing row by row, frame times within the log's.",
   };
   u.options = {
       {"rgb", "PATTERN", "colour PNGs, e.g. frames/color_%06d.png", ""},
       {"depth", "PATTERN", "16-bit depth PNGs matching --rgb, e.g. frames/depth_%06d.png", ""},
       {"pcd", "PATTERN", "instead of --rgb/--depth: point clouds (.pcd, camera frame, with rgb if any)", ""},
       {"start", "N", "index of the first frame", "0"},
-      {"count", "N", "frames to read (default: until the first missing index)", ""},
+      {"count", "N", "frames to read (default: until the first missing index; with --frame-times, its rows)", ""},
       {"camera", "NAME", "camera name, the records' field prefix", "front"},
       {"intrinsics", "FX,FY,CX,CY", "pinhole intrinsics in pixels (needed for depth images)", ""},
       {"camera-pose", "X,Y,Z,QX,QY,QZ,QW", "camera-to-world pose, metres and unit quaternion", ""},
       {"extrinsics", "M00,...,M33", "camera-to-world 4x4 matrix, 16 numbers row by row (instead of --camera-pose)", ""},
       {"depth-unit", "M", "metres per depth count", "0.001"},
       {"joints", "FILE.csv", "robot state per frame: 7 joint angles (rad)[, gripper opening (m)]", ""},
+      {"joint-log", "FILE.csv", "instead of --joints: time (s), 7 joint angles (rad), gripper opening (m)[, open 1/0]", ""},
+      {"frame-times", "FILE.csv", "each frame's time (s) on the joint log's clock, one row per frame", ""},
+      {"success", "0|1", "the recording is one demonstration, successful (1) or not (0); needs --joint-log", ""},
       {"task", "NAME", "the records' task name", "real"},
       {"episode-length", "N", "next-best poses per episode (the networks' time input scales by it)", "10"},
       voxels::no_points_option(),
   };
   u.options.push_back(cli::output_file());
+  u.add_options(stream::append_options());
   u.examples = {
       {"obs-pack --rgb rec/color_%06d.png --depth rec/depth_%06d.png --intrinsics 615.2,615.0,320.5,240.1 "
        "--camera-pose 1.05,0,1.602,-0.63365,-0.63365,0.31383,0.31383 --joints rec/joints.csv > real.rec",
        "a RealSense recording with the arm's joint log"},
+      {"obs-pack --rgb demo1/color_%06d.png --depth demo1/depth_%06d.png --intrinsics 615.2,615.0,320.5,240.1 "
+       "--camera-pose 1.05,0,1.602,-0.63365,-0.63365,0.31383,0.31383 --joint-log demo1/joints.csv "
+       "--frame-times demo1/frames.csv --success 1 --task reach_prism --append --output demos.rec",
+       "one tele-operated demonstration added to demos.rec, for keyframe"},
       {"obs-pack ... < /dev/null | qte-select --checkpoint run/latest.rec --k 10 --png q/ | plan-path | stream-dump --type trajectory",
        "what the learned agent would do on each saved frame"},
       {"obs-pack --pcd clouds/%06d.pcd --camera-pose 1.05,0,1.602,-0.63365,-0.63365,0.31383,0.31383 | voxelize --png grids/",
        "voxelize saved clouds and look at the grids"},
   };
-  u.see_also = {"sim-step(1)", "voxelize(1)", "qte-select(1)", "plan-path(1)", "qte-stream(5)"};
+  u.see_also = {"sim-step(1)", "voxelize(1)", "qte-select(1)", "plan-path(1)", "keyframe(1)", "qte-stream(5)"};
   return u;
 }
 
@@ -99,12 +125,28 @@ static void run(const cli::Arguments& args) {
   recording.episode_length = static_cast<int>(args.integer("episode-length", 1, 1000));
   recording.task = args.text("task");
   const robot::RobotModel robot = robot::RobotModel::xarm7();
+  if (args.has("joints") && args.has("joint-log")) throw UsageError("give --joints or --joint-log, not both");
+  if (args.has("joint-log") != args.has("frame-times")) throw UsageError("--joint-log and --frame-times go together");
+  if (args.has("success") && !args.has("joint-log"))
+    throw UsageError("--success needs --joint-log and --frame-times (keyframes are found from the joint velocities)");
   if (args.has("joints")) {
     recording.joints_path = args.text("joints");
     recording.states = camera_recordings::read_joint_csv(recording.joints_path, robot);
   }
+  if (args.has("joint-log"))
+    camera_recordings::add_joint_log(recording, camera_recordings::read_joint_log(args.text("joint-log"), robot),
+                                     camera_recordings::read_frame_times(args.text("frame-times")));
+  if (args.has("success")) recording.demonstration_success = args.integer("success", 0, 1) == 1;
 
-  stream::RecordWriter writer(args.text("output"));
+  std::vector<std::string> inputs;
+  for (const char* file : {"joints", "joint-log", "frame-times"})
+    if (args.has(file)) inputs.push_back(args.text(file));
+  const stream::WriteOptions write_options = stream::write_options_from(args, inputs);
+  // An append is record by record: every frame is read and checked once before, so that a bad
+  // one leaves the file as it was rather than half a demonstration in it.
+  if (write_options.mode == stream::WriteMode::append && args.text("output") != "-")
+    camera_recordings::pack_recording(recording, robot, [](const stream::Record&) {});
+  stream::RecordWriter writer(args.text("output"), write_options);
   const auto packed = camera_recordings::pack_recording(recording, robot, [&](const stream::Record& obs) { writer.write(obs); });
   writer.close();
   // Not an error here (other bounds may suit), but qte-select and qattn-train refuse such frames.

@@ -1,9 +1,5 @@
 #include "camera_recordings/camera_recordings.hpp"
 
-#include <cmath>
-#include <cstdlib>
-#include <fstream>
-
 #include "common/error.hpp"
 #include "robot/pose_values.hpp"
 
@@ -80,10 +76,14 @@ void add_robot_state(stream::Record& obs, const RobotState& state, const robot::
                      const Eigen::Isometry3d& world_from_base) {
   const Eigen::Isometry3d tcp = world_from_base * robot.tcp_pose(state.joints);
   obs.set<double>("joint_positions", {robot::kArmJoints}, state.joints.data());
-  obs.set<double>("joint_velocities", {robot::kArmJoints}, std::vector<double>(robot::kArmJoints, 0.0));
+  obs.set<double>("joint_velocities", {robot::kArmJoints}, state.joint_velocities_rad_s.data());
   obs.set<double>("gripper_pose", {robot::kPoseValues}, robot::pose_values(tcp));
-  obs.set_scalar<uint8_t>("gripper_open", state.gripper_opening_m > robot.max_finger_opening_m() / 2);
+  obs.set_scalar<uint8_t>("gripper_open", gripper_is_open(state, robot));
   obs.set_scalar<double>("gripper_opening_m", state.gripper_opening_m);
+}
+
+bool gripper_is_open(const RobotState& state, const robot::RobotModel& robot) {
+  return state.gripper_open.value_or(state.gripper_opening_m > robot.max_finger_opening_m() / 2);
 }
 
 void add_episode_fields(stream::Record& obs, int step, int episode_length, const std::string& task) {
@@ -99,90 +99,6 @@ void add_episode_fields(stream::Record& obs, int step, int episode_length, const
   obs.set_string("description", "");
   obs.set_scalar<int32_t>("variation", 0);
   obs.set_scalar<int64_t>("episode_seed", 0);
-}
-
-namespace {
-
-// One CSV cell: a finite number, a number that is not finite (nan, inf, 1e999) or not a number.
-enum class Cell { finite, not_finite, not_a_number };
-
-Cell read_cell(const std::string& text, double& value) {
-  const char* s = text.c_str();
-  char* end = nullptr;
-  value = std::strtod(s, &end);
-  while (end && (*end == ' ' || *end == '\t' || *end == '\r')) ++end;
-  if (end == s || *end != '\0') return Cell::not_a_number;
-  return std::isfinite(value) ? Cell::finite : Cell::not_finite;
-}
-
-// Cells between commas: "a,,b," is four cells, the second and last empty.
-std::vector<std::string> cells_of(const std::string& line) {
-  std::vector<std::string> cells(1);
-  for (char c : line) {
-    if (c == ',') cells.emplace_back();
-    else cells.back() += c;
-  }
-  return cells;
-}
-
-std::string shown(std::string cell) {
-  while (!cell.empty() && (cell.back() == '\r' || cell.back() == ' ')) cell.pop_back();
-  if (cell.empty()) return "empty";
-  if (cell.size() > 32) return "a " + std::to_string(cell.size()) + "-character text";
-  for (char& c : cell)
-    if (c < 0x20 || c > 0x7e) c = '?';
-  return "'" + cell + "'";
-}
-
-}  // namespace
-
-std::vector<RobotState> read_joint_csv(const std::string& path, const robot::RobotModel& robot) {
-  std::ifstream in(path);
-  if (!in) throw_system_error("cannot open " + path);
-  std::vector<RobotState> states;
-  const robot::JointVector lo = robot.lower_limits(), hi = robot.upper_limits();
-  const std::string columns = "7 joint angles in radians, then optionally the gripper opening in metres";
-  std::string line;
-  for (int number = 1; std::getline(in, line); ++number) {
-    if (line.empty() || line == "\r" || line[0] == '#') continue;
-    const std::vector<std::string> cells = cells_of(line);
-    std::vector<double> values(cells.size());
-    std::vector<Cell> kinds(cells.size());
-    bool any_number = false;
-    for (std::size_t c = 0; c < cells.size(); ++c) {
-      kinds[c] = read_cell(cells[c], values[c]);
-      any_number = any_number || kinds[c] != Cell::not_a_number;
-    }
-    // A first line of names is a header; "nan" or "inf" reads as a number, so a row of them is data.
-    if (number == 1 && !any_number) continue;
-    const std::string where = path + ": line " + std::to_string(number) + ": ";
-    for (std::size_t c = 0; c < cells.size(); ++c)
-      if (kinds[c] != Cell::finite)
-        throw Error(where + "column " + std::to_string(c + 1) + " is " + shown(cells[c]) + ", expected a finite number (" +
-                    columns + ")");
-    if (values.size() != 7 && values.size() != 8)
-      throw Error(where + std::to_string(values.size()) + " columns, expected 7 or 8 (" + columns + ")");
-    RobotState s;
-    for (int k = 0; k < robot::kArmJoints; ++k) {
-      s.joints[k] = values[k];
-      if (values[k] < lo[k] - 1e-6 || values[k] > hi[k] + 1e-6)
-        throw Error(where + "joint " + std::to_string(k + 1) + " at " + std::to_string(values[k]) +
-                    " rad is outside its limits (" + std::to_string(lo[k]) + ", " + std::to_string(hi[k]) +
-                    "); are the angles in degrees?");
-    }
-    if (values.size() == 8) {
-      if (!(values[7] >= 0 && values[7] <= robot.max_finger_opening_m() + 1e-6))
-        throw Error(where + "gripper opening " + std::to_string(values[7]) + " m is outside 0.." +
-                    std::to_string(robot.max_finger_opening_m()));
-      s.gripper_opening_m = values[7];
-    } else {
-      s.gripper_opening_m = robot.max_finger_opening_m();
-    }
-    states.push_back(s);
-  }
-  if (in.bad()) throw_system_error("cannot read " + path);
-  if (states.empty()) throw Error(path + ": no rows, expected one row per frame (" + columns + ")");
-  return states;
 }
 
 }  // namespace qte::camera_recordings

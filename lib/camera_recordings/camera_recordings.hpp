@@ -25,10 +25,14 @@ struct CameraSetup {
   bool store_points = true;                   // also write <name>.points (plan-path needs them)
 };
 
-// The robot at one frame: arm joints (rad) and the distance between the fingers (m).
+// The robot at one frame: arm joints (rad) and the distance between the fingers (m); from a
+// time-stamped joint log (joint_log.hpp) also the joints' velocities and, when the log has it,
+// whether the gripper is open (closed on an object, the fingers may stand more than half open).
 struct RobotState {
   robot::JointVector joints = robot::JointVector::Zero();
   double gripper_opening_m = 0.085;
+  robot::JointVector joint_velocities_rad_s = robot::JointVector::Zero();
+  std::optional<bool> gripper_open;  // none: open when the fingers are more than half open
 };
 
 // Adds the camera's fields for a colour image (8-bit, 3 channels, BGR as OpenCV reads it) and a
@@ -42,10 +46,11 @@ void add_camera_images(stream::Record& obs, const CameraSetup& camera, const cv:
 // it): <name>.points in the world frame, <name>.rgb, and the intrinsics when set.
 void add_camera_cloud(stream::Record& obs, const CameraSetup& camera, const voxels::CameraCloud& cloud);
 
-// joint_positions, joint_velocities (0), gripper_pose (forward kinematics), gripper_open
-// (fingers more than half open), gripper_opening_m.
+// joint_positions, joint_velocities, gripper_pose (forward kinematics), gripper_open (the
+// state's, else fingers more than half open), gripper_opening_m.
 void add_robot_state(stream::Record& obs, const RobotState& state, const robot::RobotModel& robot,
                      const Eigen::Isometry3d& world_from_base);
+bool gripper_is_open(const RobotState& state, const robot::RobotModel& robot);
 
 // step, frame, episode_length, task, description, and an episode that has not ended
 // (reward 0, terminal 0, success 0, ignore_collisions 0, variation 0, episode_seed 0).

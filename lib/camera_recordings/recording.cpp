@@ -2,14 +2,17 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <cstring>
 
 #include "camera_recordings/png_frames.hpp"
 #include "common/error.hpp"
+#include "keyframes/keyframes.hpp"
 #include "point_clouds/pcd_file.hpp"
 #include "robot/pose_values.hpp"
+#include "tasks/episode.hpp"
 #include "voxels/observation_cloud.hpp"
 #include "world/scene_layout.hpp"
 
@@ -74,16 +77,55 @@ bool exists(const std::string& path) {
 }
 }  // namespace
 
+void add_joint_log(Recording& recording, const JointLog& log, const FrameTimes& frames) {
+  recording.joints_path = frames.path;
+  recording.states = states_at(log, frames);
+  recording.times_s.clear();
+  for (double t : frames.times_s) recording.times_s.push_back(t - frames.times_s.front());
+  if (recording.count < 0) recording.count = static_cast<int64_t>(frames.times_s.size());
+}
+
+std::vector<int> demonstration_steps(const std::vector<RobotState>& states, const robot::RobotModel& robot) {
+  std::vector<keyframes::FrameState> frames(states.size());
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    frames[i].gripper_open = gripper_is_open(states[i], robot);
+    for (int k = 0; k < robot::kArmJoints; ++k) frames[i].joint_velocities[k] = states[i].joint_velocities_rad_s[k];
+  }
+  const std::vector<int> keyframes = keyframes::discover_keyframes(frames);
+  std::vector<int> steps(states.size(), 0);
+  for (std::size_t i = 1; i < steps.size(); ++i)
+    steps[i] = 1 + static_cast<int>(std::lower_bound(keyframes.begin(), keyframes.end(), static_cast<int>(i)) -
+                                    keyframes.begin());
+  return steps;
+}
+
 PackedRecording pack_recording(const Recording& recording, const robot::RobotModel& robot,
                                const std::function<void(const stream::Record&)>& emit) {
   const bool images = recording.pcd_pattern.empty();
   const std::string& pattern = images ? recording.rgb_pattern : recording.pcd_pattern;
   const bool has_states = !recording.joints_path.empty();
+  int64_t count = recording.count;
+  std::vector<int> steps;  // a demonstration's
+  if (recording.demonstration_success) {
+    // Its steps and its end need every frame's state before the first frame is packed.
+    if (!has_states)
+      throw Error("a demonstration needs the robot's state at every frame (its keyframes are found from them)");
+    if (count < 0) count = static_cast<int64_t>(recording.states.size());
+    if (static_cast<int64_t>(recording.states.size()) < count)
+      throw Error(recording.joints_path + ": " + std::to_string(recording.states.size()) +
+                  " rows for a demonstration of " + std::to_string(count) + " frames, expected one row per frame");
+    if (count < 2)
+      throw Error(recording.joints_path + ": a demonstration of " + std::to_string(count) +
+                  " frame, expected at least two");
+    steps = demonstration_steps({recording.states.begin(), recording.states.begin() + count}, robot);
+  }
   PackedRecording packed;
-  for (int64_t index = recording.start; recording.count < 0 || packed.written < recording.count; ++index) {
+  for (int64_t index = recording.start; count < 0 || packed.written < count; ++index) {
     const std::string first = frame_path(pattern, index);
     if (!exists(first)) {
-      if (recording.count >= 0) throw Error(first + ": no such frame (--count " + std::to_string(recording.count) + ")");
+      if (count >= 0)
+        throw Error(first + ": no such frame (" + std::to_string(count) + " frames from " +
+                    std::to_string(recording.start) + ")");
       break;
     }
     stream::Record obs("obs");
@@ -104,6 +146,16 @@ PackedRecording pack_recording(const Recording& recording, const robot::RobotMod
       obs.set_scalar<double>("gripper_opening_m", robot.max_finger_opening_m());
     }
     add_episode_fields(obs, static_cast<int>(packed.written), recording.episode_length, recording.task);
+    if (!recording.times_s.empty()) obs.set_scalar<double>("time_s", recording.times_s.at(packed.written));
+    if (recording.demonstration_success) {
+      obs.set_scalar<int32_t>("step", steps[packed.written]);
+      if (packed.written + 1 == count) {
+        const bool success = *recording.demonstration_success;
+        obs.set_scalar<float>("reward", success ? tasks::kSuccessReward : 0.0f);
+        obs.set_scalar<uint8_t>("terminal", 1);
+        obs.set_scalar<uint8_t>("success", success);
+      }
+    }
     const voxels::ObservationCloud cloud = voxels::observation_cloud(obs);
     if (voxels::points_inside(cloud.view(), voxels::GridBounds{}) == 0) packed.blind += 1;
     emit(obs);

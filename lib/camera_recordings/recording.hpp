@@ -1,15 +1,18 @@
 // A saved recording made into a stream of 'obs' records, what obs-pack does: frames named by a
 // printf-style pattern, read from a first index until the first missing one (or exactly a
 // count), each with the camera's setup, the robot's state from a joint log when there is one,
-// and the fields of one episode of `episode_length` steps after another.
+// and the fields of one episode of `episode_length` steps after another, or of one recorded
+// demonstration.
 #pragma once
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "camera_recordings/camera_recordings.hpp"
+#include "camera_recordings/joint_log.hpp"
 
 namespace qte::camera_recordings {
 
@@ -32,9 +35,25 @@ struct Recording {
   int episode_length = 10;
   std::string task;
   CameraSetup camera;
-  std::string joints_path;         // the joint log the states came from ("" for none)
+  std::string joints_path;         // the file whose rows gave the states: joint CSV or frame times ("" for none)
   std::vector<RobotState> states;  // one per frame written, from the first
+  std::vector<double> times_s;     // each frame's time, from the first frame's (empty: all 0)
+  // One whole demonstration that succeeded or not: frames numbered from 0, steps as
+  // demo-record's (0 at the first frame, then 1 + the keyframes before the frame: the motion it
+  // belongs to), the last frame terminal with the success and its reward. Needs every frame's
+  // state (count, or one state per frame).
+  std::optional<bool> demonstration_success;
 };
+
+// The robot's state at each frame from a joint log at the frames' times, and the frames' times
+// from the first frame's; the frames are the ones timed (the count, unless set). Error naming
+// the frame times' line when one is outside the log's span.
+void add_joint_log(Recording& recording, const JointLog& log, const FrameTimes& frames);
+
+// The step of each frame of a demonstration, as demo-record numbers them: 0 at the first frame,
+// then 1 + the keyframes (keyframe's rule, on the states' joint velocities and gripper) before
+// the frame.
+std::vector<int> demonstration_steps(const std::vector<RobotState>& states, const robot::RobotModel& robot);
 
 struct PackedRecording {
   int64_t written = 0;

@@ -146,6 +146,10 @@ stream::Record frame_record(const stream::Record& obs, int64_t episode_key) {
       // Millimetres in 16 bits: 0.5 mm rounding, far below a 1.9 cm voxel, half the bytes.
       const auto depth = obs.array<float>(name);
       frame.set<uint16_t>(name + "_mm", depth.shape, voxels::depth_in_mm(depth.data, depth.size()), /*compress=*/true);
+    } else if (stream::ends_with(name, ".depth_mm")) {  // a depth camera's own millimetres (obs-pack)
+      stream::Field mm = field;
+      mm.compress = true;
+      frame.add(mm);
     } else if (stream::ends_with(name, ".intrinsics") || stream::ends_with(name, ".extrinsics")) {
       frame.add(field);
     }
