@@ -33,41 +33,42 @@ newest_checkpoint_step() {  # DIR -> the step of its newest checkpoint, -1 for n
   echo "$best"
 }
 
-# The agent acting in the simulator, a pipeline closed by a FIFO:
-#   agent_loop [--only-trajectories-back] FIFO sim-step ARG... qte-select ARG... plan-path ARG... ['|' CONSUMER...]
+# The agent acting in its world, a pipeline closed by a FIFO:
+#   agent_loop [--only-trajectories-back] FIFO STAGE ARG... qte-select ARG... plan-path ARG... ['|' CONSUMER...]
 # runs
-#   sim-step ARG... < FIFO | qte-select ARG... | plan-path ARG... | tee FIFO [| CONSUMER...]
-# sim-step's observations go to qte-select (the next-best pose) and plan-path (its trajectory);
-# plan-path's stream (observations, actions, trajectories) goes back to sim-step through FIFO
-# (made here, an old one removed) and on to CONSUMER, or to standard output without one. With
-# --only-trajectories-back only the trajectories go back (stream-cat --type trajectory), so a
-# sim-step waiting at its --gate holds nothing in flight. The programs' names separate their
-# arguments. The exit statuses of the pipeline's programs, in order, are left in the array
-# agent_loop_status (for a caller without set -e).
+#   STAGE ARG... < FIFO | qte-select ARG... | plan-path ARG... | tee FIFO [| CONSUMER...]
+# STAGE (sim-step, or robot-step for a real robot) writes observations to qte-select (the
+# next-best pose) and plan-path (its trajectory); plan-path's stream (observations, actions,
+# trajectories) goes back to STAGE through FIFO (made here, an old one removed) and on to
+# CONSUMER, or to standard output without one. With --only-trajectories-back only the
+# trajectories go back (stream-cat --type trajectory), so a stage waiting at its --gate holds
+# nothing in flight. The programs' names separate their arguments. The exit statuses of the
+# pipeline's programs, in order, are left in the array agent_loop_status (for a caller without
+# set -e).
 agent_loop() {
-  local back=(tee) fifo stage=sim-step sim=() select=() plan=()
+  local back=(tee) fifo part=stage world=() select=() plan=()
   if [ "$1" = --only-trajectories-back ]; then back=(send_trajectories_back); shift; fi
   fifo=$1
-  [ "${2-}" = sim-step ] || { echo "agent_loop: expected sim-step after the FIFO, not '${2-}'" >&2; return 2; }
-  shift 2
+  shift
   while [ $# -gt 0 ] && [ "$1" != '|' ]; do
-    case $stage:$1 in
-      sim-step:qte-select) stage=qte-select ;;
-      qte-select:plan-path) stage=plan-path ;;
-      sim-step:*) sim+=("$1") ;;
+    case $part:$1 in
+      stage:qte-select) part=qte-select ;;
+      qte-select:plan-path) part=plan-path ;;
+      stage:*) world+=("$1") ;;
       qte-select:*) select+=("$1") ;;
       plan-path:*) plan+=("$1") ;;
     esac
     shift
   done
-  [ "$stage" = plan-path ] || { echo "agent_loop: expected qte-select then plan-path among its arguments" >&2; return 2; }
+  [ "${#world[@]}" -gt 0 ] || { echo "agent_loop: expected the stage (sim-step, robot-step) after the FIFO" >&2; return 2; }
+  [ "$part" = plan-path ] || { echo "agent_loop: expected qte-select then plan-path among its arguments" >&2; return 2; }
   [ $# -eq 0 ] || shift  # the '|': what follows is the consumer
   rm -f "$fifo"
   mkfifo "$fifo"
   if [ $# -gt 0 ]; then
-    sim-step "${sim[@]}" < "$fifo" | qte-select "${select[@]}" | plan-path "${plan[@]}" | "${back[@]}" "$fifo" | "$@"
+    "${world[@]}" < "$fifo" | qte-select "${select[@]}" | plan-path "${plan[@]}" | "${back[@]}" "$fifo" | "$@"
   else
-    sim-step "${sim[@]}" < "$fifo" | qte-select "${select[@]}" | plan-path "${plan[@]}" | "${back[@]}" "$fifo"
+    "${world[@]}" < "$fifo" | qte-select "${select[@]}" | plan-path "${plan[@]}" | "${back[@]}" "$fifo"
   fi
   agent_loop_status=("${PIPESTATUS[@]}")
 }

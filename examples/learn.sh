@@ -41,6 +41,13 @@
 #
 # LABEL names the run in its CSVs; by default run_label (common.sh) of METHOD (qte), ACT_K,
 # TARGET_K, K_MARGIN and K_MAX, as examples/Makefile labels its runs.
+#
+# A real robot (docs/real-world.md): STAGE is the world the agent acts in, a program with its
+# options (quoted words stay together): the simulator at IMAGE by default, or robot-step with
+# its spool, camera and judge; EVAL_STAGE the world of the evaluations (STAGE by default).
+# DEMOS_FROM=FILE takes the demonstrations from recorded ones (obs-pack) instead of the
+# simulator's expert; TIME_BUDGET=S stops starting chunks after S seconds of wall-clock
+# training (evaluations excluded), paced like CPU_BUDGET: the paper's "10 minutes" on a robot.
 set -euo pipefail
 task=$1 run=$2
 source "$(dirname "$0")/common.sh"
@@ -50,6 +57,10 @@ source "$(dirname "$0")/common.sh"
 : "${LEARNER_THREADS:=1}" "${EPSILON:=0.1}" "${ROTATION_NOISE:=1}" "${CHECKPOINT_EVERY:=25}"
 : "${N_STEP:=1}" "${ACTORS:=1}" "${CPU_BUDGET:=0}" "${K_MARGIN:=0.02}" "${K_MAX:=10}" "${ROLE:=all}" "${ACTOR_INDEX:=0}"
 : "${ALSO_ACT_K:=}" "${METHOD:=qte}" "${LABEL:=$(run_label "$METHOD" "$ACT_K" "$TARGET_K" "$K_MARGIN" "$K_MAX")}"
+: "${STAGE:=sim-step --image-size $IMAGE}" "${DEMOS_FROM:=}" "${TIME_BUDGET:=0}"
+: "${EVAL_STAGE:=$STAGE}"
+eval "stage=($STAGE)"
+eval "eval_stage=($EVAL_STAGE)"
 mkdir -p "$run/actors" "$run/eval"
 # The script's own waiting costs no process (it is counted in the budget, and a method that
 # takes longer would pay more for it): a read with a timeout on a FIFO nobody writes.
@@ -119,7 +130,11 @@ cpu_columns() {
 # steps the replay ratio allows, so a run's environment and learner steps follow from its
 # settings and seed, not from how the machine shares its cores. Once the budget is spent no
 # chunk starts, and the final evaluation takes the learner's newest checkpoint as it stands.
-out_of_budget() { [ "$CPU_BUDGET" -gt 0 ] && [ "$(cpu_seconds)" -ge "$CPU_BUDGET" ]; }
+out_of_budget() {
+  { [ "$CPU_BUDGET" -gt 0 ] && [ "$(cpu_seconds)" -ge "$CPU_BUDGET" ]; } ||
+    { [ "$TIME_BUDGET" -gt 0 ] && [ $(( $(cat "$run/train_seconds" 2>/dev/null || echo 0) + $(date +%s) - clock )) -ge "$TIME_BUDGET" ]; }
+}
+budgeted() { [ "$CPU_BUDGET" -gt 0 ] || [ "$TIME_BUDGET" -gt 0 ]; }
 
 # A process that ended, in words: "exit status N" or "killed by signal NAME".
 describe_status() {
@@ -168,7 +183,7 @@ next_chunk() {  # ACTOR -> its first chunk not finished
 }
 # Environment steps of the finished chunks.
 finished_steps() { { cat "$run"/actors/gate-*/[0-9]*.steps 2>/dev/null || true; } | awk '{ n += $1 } END { print n + 0 }'; }
-actor_programs=(sim-step qte-select plan-path tee keyframe)
+actor_programs=("${stage[0]}" qte-select plan-path tee keyframe)
 start_actor() {  # ACTOR: its pipeline, in the background, from its first chunk not finished
   local i=$1 gate
   gate=$(gate_dir "$i")
@@ -177,9 +192,8 @@ start_actor() {  # ACTOR: its pipeline, in the background, from its first chunk 
   (
     set +e  # the status of every program is what this subshell is for
     agent_loop --only-trajectories-back "$run/actors/loop-$i" \
-      sim-step --task "$task" --variation "$VARIATION" --episodes 10000000 --seed $(( SEED * 100000 )) --scenes explore \
-        --chunk-episodes "$CHUNK_EPISODES" --first-chunk "$(next_chunk "$i")" --chunk-stride "$ACTORS" --gate "$gate" \
-        --image-size "$IMAGE" --compress \
+      "${stage[@]}" --task "$task" --variation "$VARIATION" --episodes 10000000 --seed $(( SEED * 100000 )) --scenes explore \
+        --chunk-episodes "$CHUNK_EPISODES" --first-chunk "$(next_chunk "$i")" --chunk-stride "$ACTORS" --gate "$gate" --compress \
       qte-select --checkpoint "$run/ckpt/latest.rec" --reload --k "$ACT_K" $act_branching --epsilon "$EPSILON" \
         --rotation-noise "$ROTATION_NOISE" --seed $(( SEED * 100000 + i )) --threads 1 \
       plan-path \
@@ -252,10 +266,15 @@ fi
 
 # 1. Demonstrations -> transitions (once; written under a temporary name, then renamed).
 if [ ! -f "$run/replay.rec" ]; then
-  log "$task: $DEMOS demonstrations"
   before=$(shell_ticks)
-  demo-record --task "$task" --episodes "$DEMOS" --seed "$SEED" --scenes demo --variation "$VARIATION" --image-size "$IMAGE" \
-    --compress --output "$run/demos.rec" 2>> "$run/demos.log"
+  if [ -n "$DEMOS_FROM" ]; then
+    log "$task: the recorded demonstrations of $DEMOS_FROM"
+    stream-cat --output "$run/demos.rec" "$DEMOS_FROM" 2>> "$run/demos.log"
+  else
+    log "$task: $DEMOS demonstrations"
+    demo-record --task "$task" --episodes "$DEMOS" --seed "$SEED" --scenes demo --variation "$VARIATION" --image-size "$IMAGE" \
+      --compress --output "$run/demos.rec" 2>> "$run/demos.log"
+  fi
   keyframe --seed "$SEED" --output "$run/replay.rec.tmp" "$run/demos.rec" 2>> "$run/demos.log"
   mv "$run/replay.rec.tmp" "$run/replay.rec"
   demos_ticks=$(( $(shell_ticks) - before ))
@@ -302,8 +321,7 @@ wait_for_learner() {
 evaluate() {  # CHECKPOINT ENV_STEPS OUT.csv LEARNER_STEP EVAL_POINT
   local fifo; fifo=$(mktemp -u)
   agent_loop "$fifo" \
-    sim-step --task "$task" --variation "$VARIATION" --episodes "$EVAL_EPISODES" --seed "$EVAL_SEED" --scenes eval \
-      --image-size "$IMAGE" \
+    "${eval_stage[@]}" --task "$task" --variation "$VARIATION" --episodes "$EVAL_EPISODES" --seed "$EVAL_SEED" --scenes eval \
     qte-select --checkpoint "$1" --k "$ACT_K" $act_branching --threads 1 \
     plan-path \
     '|' episode-stats --label "$LABEL" --column seed="$SEED" --column env_steps="$2" --column train_step="$4" \
@@ -343,7 +361,7 @@ while :; do
   if [ "$ROLE" = learner ]; then check_learner; nap 5; continue; fi
 
   # Under a budget, the actor is paced by the learner (see out_of_budget).
-  if [ "$CPU_BUDGET" -gt 0 ]; then
+  if budgeted; then
     wait_for_learner "$env_steps"
     if out_of_budget; then continue; fi
   fi
@@ -364,7 +382,8 @@ trap - EXIT
 cat "$run"/eval/*.csv | awk 'NR == 1 || !/^label/' > "$run/eval.csv"
 # Where the final networks' agent goes on the evaluation scenes, beside the expert on the same
 # scenes (failure_reasons.sh: the last evaluation's episodes again, deterministic).
-if [ ! -f "$run/failures.csv" ]; then
+# The simulator's analysis: not for a real robot's runs.
+if [ "${stage[0]}" = sim-step ] && [ ! -f "$run/failures.csv" ]; then
   VARIATION=$VARIATION EVAL_SEED=$EVAL_SEED bash "$(dirname "$0")/failure_reasons.sh" "$task" "$run/eval/checkpoint.rec" \
     "$ACT_K" "$IMAGE" "$EVAL_EPISODES" "$LABEL" "$SEED" $act_branching > "$run/failures.csv.tmp" 2>> "$run/actor.log" \
     && mv "$run/failures.csv.tmp" "$run/failures.csv" || log "$task $LABEL seed $SEED: no failure analysis (see actor.log)"
@@ -372,7 +391,7 @@ fi
 # ALSO_ACT_K=K[,K...]: the final networks acting with other K as well (trained with one method,
 # acting with another), each into failures-act-kK.csv.
 for k in ${ALSO_ACT_K//,/ }; do
-  [ "$k" != "$ACT_K" ] && [ ! -f "$run/failures-act-k$k.csv" ] || continue
+  [ "${stage[0]}" = sim-step ] && [ "$k" != "$ACT_K" ] && [ ! -f "$run/failures-act-k$k.csv" ] || continue
   VARIATION=$VARIATION EVAL_SEED=$EVAL_SEED bash "$(dirname "$0")/failure_reasons.sh" "$task" "$run/eval/checkpoint.rec" \
     "$k" "$IMAGE" "$EVAL_EPISODES" "$LABEL" "$SEED" > "$run/failures-act-k$k.csv.tmp" 2>> "$run/actor.log" \
     && mv "$run/failures-act-k$k.csv.tmp" "$run/failures-act-k$k.csv" || log "$task $LABEL seed $SEED: no analysis acting with K = $k"

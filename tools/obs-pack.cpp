@@ -1,11 +1,11 @@
 // obs-pack: saved RGB-D camera frames (colour + 16-bit depth PNGs, or .pcd clouds) to 'obs' records.
 #include <iostream>
 
+#include "camera_recordings/camera_options.hpp"
 #include "camera_recordings/recording.hpp"
 #include "cli/command.hpp"
 #include "stream/stream_options.hpp"
 #include "stream/writer.hpp"
-#include "voxels/observation_cloud.hpp"
 
 using namespace qte;
 
@@ -63,19 +63,14 @@ static cli::Usage usage() {
       {"pcd", "PATTERN", "instead of --rgb/--depth: point clouds (.pcd, camera frame, with rgb if any)", ""},
       {"start", "N", "index of the first frame", "0"},
       {"count", "N", "frames to read (default: until the first missing index; with --frame-times, its rows)", ""},
-      {"camera", "NAME", "camera name, the records' field prefix", "front"},
-      {"intrinsics", "FX,FY,CX,CY", "pinhole intrinsics in pixels (needed for depth images)", ""},
-      {"camera-pose", "X,Y,Z,QX,QY,QZ,QW", "camera-to-world pose, metres and unit quaternion", ""},
-      {"extrinsics", "M00,...,M33", "camera-to-world 4x4 matrix, 16 numbers row by row (instead of --camera-pose)", ""},
-      {"depth-unit", "M", "metres per depth count", "0.001"},
       {"joints", "FILE.csv", "robot state per frame: 7 joint angles (rad)[, gripper opening (m)]", ""},
       {"joint-log", "FILE.csv", "instead of --joints: time (s), 7 joint angles (rad), gripper opening (m)[, open 1/0]", ""},
       {"frame-times", "FILE.csv", "each frame's time (s) on the joint log's clock, one row per frame", ""},
       {"success", "0|1", "the recording is one demonstration, successful (1) or not (0); needs --joint-log", ""},
       {"task", "NAME", "the records' task name", "real"},
       {"episode-length", "N", "next-best poses per episode (the networks' time input scales by it)", "10"},
-      voxels::no_points_option(),
   };
+  u.add_options(camera_recordings::camera_setup_options());
   u.options.push_back(cli::output_file());
   u.add_options(stream::append_options());
   u.examples = {
@@ -95,21 +90,6 @@ static cli::Usage usage() {
   return u;
 }
 
-static camera_recordings::CameraSetup camera_setup(const cli::Arguments& args) {
-  camera_recordings::CameraSetup camera;
-  camera.name = args.text("camera");
-  if (!stream::is_valid_field_name(camera.name + ".rgb")) throw UsageError("--camera: not a usable field name");
-  if (args.has("intrinsics"))
-    camera.intrinsics = camera_recordings::intrinsics_from_values(args.reals("intrinsics", 4), "intrinsics");
-  if (args.has("camera-pose") == args.has("extrinsics")) throw UsageError("give the camera's pose: one of --camera-pose and --extrinsics");
-  camera.camera_to_world = args.has("camera-pose")
-                               ? camera_recordings::camera_pose_from_values(args.reals("camera-pose", 7), "camera-pose")
-                               : camera_recordings::camera_pose_from_matrix(args.reals("extrinsics", 16), "extrinsics");
-  camera.depth_unit_m = args.real("depth-unit", 1e-6, 1.0);
-  camera.store_points = !args.flag("no-points");
-  return camera;
-}
-
 static void run(const cli::Arguments& args) {
   camera_recordings::Recording recording;
   const bool images = args.has("rgb") || args.has("depth");
@@ -118,7 +98,7 @@ static void run(const cli::Arguments& args) {
   recording.rgb_pattern = args.text("rgb");
   recording.depth_pattern = args.text("depth");
   recording.pcd_pattern = args.text("pcd");
-  recording.camera = camera_setup(args);
+  recording.camera = camera_recordings::camera_setup_from(args);
   if (images && !recording.camera.intrinsics) throw UsageError("depth images need --intrinsics");
   recording.start = args.integer("start", 0, 1000000000);
   recording.count = args.has("count") ? args.integer("count", 1, 1000000000) : -1;

@@ -35,10 +35,11 @@ static cli::Usage usage() {
       "arm is, within the joint limits, no joint faster than --speed of its limit (slower "
       "motions are stretched in time to fit), and the gripper inside --workspace along the whole "
       "path. A motion that fails a check is not sent, and ends the episode with reward 0 and the "
-      "reason, as an invalid action does in sim-step. The stop file (--stop-file), an interrupt, "
-      "or a driver that does not answer in time writes 'stop' in the spool, which halts the "
-      "drivers at once, and ends robot-step with exit status 1. --dry-run sends nothing: it "
-      "prints each motion and takes it as reached.",
+      "reason, as an invalid action does in sim-step. The stop file (--stop-file), a 'stop' a "
+      "person writes in the spool, or a driver that does not answer in time ends robot-step with "
+      "exit status 1; an interrupt (SIGINT, SIGTERM) ends it by the signal. Each writes 'stop' in "
+      "the spool, which halts the drivers at once, and withdraws the motion not yet answered. "
+      "--dry-run sends nothing: it prints each motion and takes it as reached.",
       "Episodes: each reset asks for the scene to be set up, then moves the arm to --home with "
       "the gripper open. After each step the outcome comes from a person at the terminal (s "
       "success, f failure, Enter go on; q stops), from a file (--outcomes), or from a command "

@@ -93,6 +93,11 @@ int register_temp(const std::string& path, TempKind kind = kFile) {
   return -1;  // still correct, only not cleaned up on a signal
 }
 
+void unregister_temp(const std::string& path) {
+  std::lock_guard<std::mutex> lock(g_mutex);
+  for (int i = 0; i < kMaxTempFiles; ++i)
+    if (g_temp_kind[i] != kFree && path == g_temp_paths[i]) g_temp_kind[i] = kFree;
+}
 }  // namespace
 
 void write_on_fatal_signal(const std::string& path, const std::string& text) {
@@ -105,13 +110,10 @@ void write_on_fatal_signal(const std::string& path, const std::string& text) {
   g_note_set = 1;
 }
 
-namespace {
+RemovedOnSignal::RemovedOnSignal(std::string path) : path_(std::move(path)) { register_temp(path_); }
+RemovedOnSignal::~RemovedOnSignal() { unregister_temp(path_); }
 
-void unregister_temp(const std::string& path) {
-  std::lock_guard<std::mutex> lock(g_mutex);
-  for (int i = 0; i < kMaxTempFiles; ++i)
-    if (g_temp_kind[i] != kFree && path == g_temp_paths[i]) g_temp_kind[i] = kFree;
-}
+namespace {
 
 // The file a chain of symbolic links ends at (the path itself when it is no link).
 std::string follow_symlinks(const std::string& path) {

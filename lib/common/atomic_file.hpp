@@ -76,6 +76,19 @@ class OutputDirectory {
 // halts when the program driving it is interrupted. One such file per process; the last call wins.
 void write_on_fatal_signal(const std::string& path, const std::string& text);
 
+// While it lives, `path` is removed if SIGINT, SIGTERM or SIGHUP ends the process: a request
+// that must not outlive the program waiting for its answer (robot-step's motions).
+class RemovedOnSignal {
+ public:
+  explicit RemovedOnSignal(std::string path);
+  ~RemovedOnSignal();
+  RemovedOnSignal(const RemovedOnSignal&) = delete;
+  RemovedOnSignal& operator=(const RemovedOnSignal&) = delete;
+
+ private:
+  std::string path_;
+};
+
 // Convenience: the whole file at once, atomically.
 void write_file_atomically(const std::string& path, const void* data, std::size_t n);
 

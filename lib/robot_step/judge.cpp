@@ -128,6 +128,7 @@ class CommandJudge : public Judge {
 
  private:
   static void set_episode(const EpisodeInfo& e) {
+    for (const char* name : {"QTE_STEP", "QTE_EPISODE_LENGTH", "QTE_MOTION", "QTE_FRAME"}) ::unsetenv(name);
     ::setenv("QTE_TASK", e.task.c_str(), 1);
     ::setenv("QTE_VARIATION", std::to_string(e.variation).c_str(), 1);
     ::setenv("QTE_SEED", std::to_string(e.seed).c_str(), 1);

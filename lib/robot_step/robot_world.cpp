@@ -1,5 +1,6 @@
 #include "robot_step/robot_world.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <ostream>
 
@@ -111,6 +112,7 @@ void RobotWorld::set_episode_fields(stream::Record& obs, const std::string& fail
   obs.set_scalar<int32_t>("variation", episode_.variation);
   obs.set_scalar<int64_t>("episode_seed", episode_.seed);
   obs.set_scalar<uint8_t>("ignore_collisions", ignore_collisions_);
+  obs.set_string("description", description_);
   if (!failure.empty()) obs.set_string("failure", failure);
 }
 
@@ -119,6 +121,10 @@ void RobotWorld::reset(const stream::Record& record, const stream::Emit& emit) {
   episode_.variation = record.has("variation") ? record.scalar<int32_t>("variation") : 0;
   episode_.seed = record.has("seed") ? record.scalar<int64_t>("seed") : 0;
   episode_.episode = episodes_++;
+  description_.clear();  // a simulated task's words, when the real scene is named after one
+  const std::vector<std::string> known = tasks::task_names();
+  if (std::find(known.begin(), known.end(), episode_.task) != known.end())
+    description_ = tasks::make_task(episode_.task)->description(episode_.variation);
   judge_.reset(episode_);
   // The start pose, reached slowly by the driver (a motion of one row), the gripper open.
   robot::XarmRow home;

@@ -65,6 +65,7 @@ class RobotWorld : public sim_step::EpisodeStage {
   bool terminal_ = true, success_ = false, ignore_collisions_ = false;
   int frame_ = 0;
   std::string last_frame_, last_motion_;  // for the judge
+  std::string description_;
 };
 
 // The factor (at least 1) a path's times must be stretched by so that no joint goes faster

@@ -66,6 +66,10 @@ bool Spool::stopped() const { return fs::exists(path("stop")); }
 void Spool::stop(const std::string& why) {
   const std::string text = why + "\n";
   write_file_atomically(path("stop"), text.data(), text.size());
+  withdraw();
+}
+
+void Spool::withdraw() {
   // A request left unanswered must not be carried out once a person has removed `stop`.
   if (last_request_.empty()) return;
   std::error_code ignored;
@@ -93,7 +97,10 @@ std::size_t Spool::wait_for(const std::vector<std::string>& names, std::chrono::
   for (;;) {
     for (std::size_t i = 0; i < names.size(); ++i)
       if (fs::exists(path(names[i]))) return i;
-    if (stopped()) throw Error(path("stop") + " exists: stopped while waiting for " + what);
+    if (stopped()) {
+      withdraw();
+      throw Error(path("stop") + " exists: stopped while waiting for " + what);
+    }
     const std::string reason = should_stop_ ? should_stop_() : "";
     if (!reason.empty()) {
       stop(reason);
@@ -101,8 +108,10 @@ std::size_t Spool::wait_for(const std::vector<std::string>& names, std::chrono::
     }
     if (std::chrono::steady_clock::now() > deadline) {
       stop("no answer to " + what);
-      throw Error("no answer to " + what + " in " + std::to_string(timeout.count() / 1000.0) + " s: " + path("stop") +
-                  " written; is the driver running on " + directory_ + "?");
+      char seconds[32];
+      std::snprintf(seconds, sizeof seconds, "%g", timeout.count() / 1000.0);
+      throw Error("no answer to " + what + " in " + seconds + " s: " + path("stop") + " written; is the driver running on " +
+                  directory_ + "?");
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
@@ -118,6 +127,7 @@ MotionAnswer Spool::move(const std::vector<robot::XarmRow>& rows, const std::str
   const std::string name = claim("motion");
   const std::string csv = robot::xarm_csv(rows, comment);
   write_file_atomically(path(name + ".xarm.csv"), csv.data(), csv.size());
+  const RemovedOnSignal pending(path(name + ".xarm.csv"));  // an interrupted wait withdraws it
   const std::size_t which = wait_for({name + ".done", name + ".fault"}, motion_timeout_, path(name + ".xarm.csv"));
   const std::string answer = path(name + (which == 0 ? ".done" : ".fault"));
   if (which == 0) return parse_done(read_all(answer), answer);

@@ -49,7 +49,8 @@ class Spool {
   const std::string& last_request() const { return last_request_; }
 
  private:
-  std::string claim(const std::string& kind);  // the next request name not used in the directory
+  std::string claim(const std::string& kind);
+  void withdraw();  // removes the last request if it has no answer  // the next request name not used in the directory
   // Waits until one of `names` exists; returns its index. Throws after `timeout` or on a stop.
   std::size_t wait_for(const std::vector<std::string>& names, std::chrono::milliseconds timeout,
                        const std::string& what);

@@ -18,7 +18,7 @@ killed=0 learners=0
 for _ in $(seq 1 2400); do
   now=$(pgrep -c -P $learn_pid -f "qattn-train --follow .*$run/replay.rec" || true)
   learners=$(( now > learners ? now : learners ))
-  if [ $killed = 0 ] && [ -f "$run/actors/gate-1/0001.go" ] && pkill -9 -f "sim-step --task reach_target .*--first-chunk 1 --chunk-stride 2"; then
+  if [ $killed = 0 ] && [ -f "$run/actors/gate-1/0001.go" ] && pkill -9 -f "sim-step .*--task reach_target .*--first-chunk 1 --chunk-stride 2"; then
     killed=1
   fi
   kill -0 $learn_pid 2>/dev/null || break
