@@ -52,3 +52,23 @@ TEST(XarmEpisode, ARefusedMotionChangesNothing) {
   EXPECT_THROW(episode.motion(time_s.data(), joints.data(), 2, true), qte::Error);
   EXPECT_EQ(move(episode, true).front().gripper, 0);
 }
+
+// A path ending a hair after a tick: the tick is dropped rather than written with the end's
+// printed time, so the file's times increase row by row (the drivers refuse a repeated time).
+TEST(XarmRows, NoTwoRowsShareAPrintedTime) {
+  const RobotModel& robot = qte::test_support::xarm();
+  const std::vector<double> time_s = {0, 1.00004};
+  std::vector<double> joints(14, 0.0);
+  joints[7] = 0.1;
+  const std::vector<XarmRow> rows = xarm_rows(time_s.data(), joints.data(), 2, 0.085, 0.085, robot, 100, 0.5);
+  const std::string csv = xarm_csv(rows, "");
+  double previous = -1;
+  std::size_t at = csv.find('\n') + 1;  // past the header
+  while (at < csv.size()) {
+    const double t = std::stod(csv.substr(at, csv.find(',', at) - at));
+    EXPECT_GT(t, previous) << csv.substr(at, 40);
+    previous = t;
+    at = csv.find('\n', at) + 1;
+  }
+  EXPECT_DOUBLE_EQ(rows[rows.size() - 2].time_s, 1.00004);  // the path's own end is kept
+}
