@@ -180,13 +180,7 @@ def main():
     spool = robot_spool.Spool(args.spool, "motion", ["done", "fault"], args.poll)
     arm = None
     if not args.dry_run:
-        if not args.ip:
-            sys.exit("--ip is required (or --dry-run)")
-        from xarm.wrapper import XArmAPI  # pip install xarm-python-sdk
-        arm = XArmAPI(args.ip)
-        arm.clean_error()
-        arm.motion_enable(enable=True)
-        arm.set_gripper_enable(True)
+        arm = xarm_play.connect(args.ip)
         arm.set_mode(0)
         arm.set_state(0)
     status = 0

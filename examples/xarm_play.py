@@ -187,6 +187,18 @@ def play(arm, rows, stopped=lambda: False, pace=1.0):
         check(arm, arm.set_servo_angle_j(angles=angles, is_radian=False), "set_servo_angle_j")
 
 
+def connect(ip):
+    """The arm at `ip` through UFACTORY's SDK: errors cleared, motors and gripper enabled."""
+    if not ip:
+        sys.exit("--ip is required (or --dry-run)")
+    from xarm.wrapper import XArmAPI  # pip install xarm-python-sdk
+    arm = XArmAPI(ip)
+    arm.clean_error()
+    arm.motion_enable(enable=True)
+    arm.set_gripper_enable(True)
+    return arm
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("files", nargs="+")
@@ -201,13 +213,7 @@ def main():
         for path, rows in moves:
             print(f"{path}: {describe(rows)}")
         return
-    if not args.ip:
-        sys.exit("--ip is required (or --dry-run)")
-    from xarm.wrapper import XArmAPI  # pip install xarm-python-sdk
-    arm = XArmAPI(args.ip)
-    arm.clean_error()
-    arm.motion_enable(enable=True)
-    arm.set_gripper_enable(True)
+    arm = connect(args.ip)
     try:
         for path, rows in moves:
             print(f"playing {path}", file=sys.stderr)

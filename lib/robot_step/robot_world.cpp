@@ -143,25 +143,20 @@ void RobotWorld::reset(const stream::Record& record, const stream::Emit& emit) {
 
 std::string RobotWorld::check_motion(const stream::Record& record, std::vector<robot::XarmRow>& rows) const {
   if (record.has("failure")) return record.string("failure");  // the planner found no path
-  const auto times = record.array<double>("time_s");
-  const auto joints = record.array<double>("joint_positions");
-  const int64_t n = times.size();
-  if (n < 1 || joints.shape != stream::Shape{n, robot::kArmJoints})
-    record.fail("joint_positions", "float64 [N, 7] with N = " + std::to_string(n) +
-                                       " (the length of time_s), got " + stream::shape_to_string(joints.shape));
+  const sim_step::TrajectoryWaypoints path = sim_step::trajectory_waypoints(record);
   robot::JointPathLimits limits;
   limits.start = &joints_;
   limits.start_tolerance_rad = kStartTolerance_rad;
-  std::string failure = robot::joint_path_failure(times.data, joints.data, n, robot_, limits);
+  std::string failure = robot::joint_path_failure(path.time_s, path.joints, path.n, robot_, limits);
   if (!failure.empty()) return failure;
-  std::vector<double> stretched(times.data, times.data + n);
-  const double stretch = time_stretch(times.data, joints.data, n, robot_, options_.speed_fraction);
+  std::vector<double> stretched(path.time_s, path.time_s + path.n);
+  const double stretch = time_stretch(path.time_s, path.joints, path.n, robot_, options_.speed_fraction);
   for (double& t : stretched) t *= stretch;
   const double after_m = !record.has("gripper_open") ? gripper_m_
                          : record.scalar<uint8_t>("gripper_open") ? robot_.max_finger_opening_m()
                                                                   : 0.0;
   try {
-    rows = robot::xarm_rows(stretched.data(), joints.data, n, gripper_m_, after_m, robot_, options_.rate_hz,
+    rows = robot::xarm_rows(stretched.data(), path.joints, path.n, gripper_m_, after_m, robot_, options_.rate_hz,
                             options_.settle_s);
   } catch (const Error& e) {
     return std::string("invalid_trajectory:") + e.what();

@@ -166,20 +166,25 @@ void Simulator::reset(const stream::Record& record, const stream::Emit& emit) {
   emit(observe());
 }
 
-std::string Simulator::check_trajectory(const stream::Record& record) const {
-  if (record.has("failure")) return record.string("failure");
-  const auto times = record.array<double>("time_s");
-  const auto joints = record.array<double>("joint_positions");
+TrajectoryWaypoints trajectory_waypoints(const stream::Record& trajectory) {
+  const auto times = trajectory.array<double>("time_s");
+  const auto joints = trajectory.array<double>("joint_positions");
   const int64_t n = times.size();
   if (n < 1 || joints.shape != stream::Shape{n, robot::kArmJoints})
-    record.fail("joint_positions", "float64 [N, 7] with N = " + std::to_string(n) +
-                                       " (the length of time_s), got " + stream::shape_to_string(joints.shape));
+    trajectory.fail("joint_positions", "float64 [N, 7] with N = " + std::to_string(n) +
+                                           " (the length of time_s), got " + stream::shape_to_string(joints.shape));
+  return {times.data, joints.data, n};
+}
+
+std::string Simulator::check_trajectory(const stream::Record& record) const {
+  if (record.has("failure")) return record.string("failure");
+  const TrajectoryWaypoints path = trajectory_waypoints(record);
   robot::JointPathLimits limits;
   limits.max_duration_s = options_.max_trajectory_s;
   const robot::JointVector now = world_->joint_positions();
   limits.start = &now;
   limits.start_tolerance_rad = kStartTolerance_rad;
-  return robot::joint_path_failure(times.data, joints.data, n, robot_, limits);
+  return robot::joint_path_failure(path.time_s, path.joints, path.n, robot_, limits);
 }
 
 void Simulator::execute(const stream::Record& record, const stream::Emit& emit) {

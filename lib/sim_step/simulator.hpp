@@ -41,6 +41,15 @@ struct SimulatorOptions {
   bool object_poses = false;
 };
 
+// The waypoints of a 'trajectory' record (time_s [N], joint_positions [N, 7] in radians), its
+// shapes checked (StreamError naming the record otherwise): what sim-step and robot-step execute.
+struct TrajectoryWaypoints {
+  const double* time_s;
+  const double* joints;
+  int64_t n;
+};
+TrajectoryWaypoints trajectory_waypoints(const stream::Record& trajectory);
+
 // The objects.* fields of an observation: every object of `world` in id order, its name
 // (objects.names, joined by commas), role (ObjectSpec::Role's code), pose, bounding box in
 // its own frame (lower then upper corner) and whether the gripper holds it (objects.held:
