@@ -42,6 +42,9 @@
 # LABEL names the run in its CSVs; by default run_label (common.sh) of METHOD (qte), ACT_K,
 # TARGET_K, K_MARGIN and K_MAX, as examples/Makefile labels its runs.
 #
+# NET_OPTIONS: the coarse-to-fine hierarchy when not the published one, for keyframe and the
+# learner alike (e.g. "--depths 3 --offset 0.15,0.05"; qte-select takes it from the checkpoint).
+#
 # A real robot (docs/real-world.md): STAGE is the world the agent acts in, a program with its
 # options (quoted words stay together): the simulator at IMAGE by default, or robot-step with
 # its spool, camera and judge; EVAL_STAGE the world of the evaluations (STAGE by default).
@@ -57,7 +60,7 @@ source "$(dirname "$0")/common.sh"
 : "${LEARNER_THREADS:=1}" "${EPSILON:=0.1}" "${ROTATION_NOISE:=1}" "${CHECKPOINT_EVERY:=25}"
 : "${N_STEP:=1}" "${ACTORS:=1}" "${CPU_BUDGET:=0}" "${K_MARGIN:=0.02}" "${K_MAX:=10}" "${ROLE:=all}" "${ACTOR_INDEX:=0}"
 : "${ALSO_ACT_K:=}" "${METHOD:=qte}" "${LABEL:=$(run_label "$METHOD" "$ACT_K" "$TARGET_K" "$K_MARGIN" "$K_MAX")}"
-: "${STAGE:=sim-step --image-size $IMAGE}" "${DEMOS_FROM:=}" "${TIME_BUDGET:=0}"
+: "${STAGE:=sim-step --image-size $IMAGE}" "${DEMOS_FROM:=}" "${TIME_BUDGET:=0}" "${NET_OPTIONS:=}"
 : "${EVAL_STAGE:=$STAGE}"
 eval "stage=($STAGE)"
 eval "eval_stage=($EVAL_STAGE)"
@@ -197,7 +200,7 @@ start_actor() {  # ACTOR: its pipeline, in the background, from its first chunk 
       qte-select --checkpoint "$run/ckpt/latest.rec" --reload --k "$ACT_K" $act_branching --epsilon "$EPSILON" \
         --rotation-noise "$ROTATION_NOISE" --seed $(( SEED * 100000 + i )) --threads 1 \
       plan-path \
-      '|' keyframe --agent --seed "$SEED" --append --output "$actor_replay"
+      '|' keyframe --agent --seed "$SEED" $NET_OPTIONS --append --output "$actor_replay"
     echo "${agent_loop_status[*]}" > "$run/actors/status-$i"
   ) 2>> "$run/actor.log" &
   actor_pids[$i]=$!
@@ -275,7 +278,7 @@ if [ ! -f "$run/replay.rec" ]; then
     demo-record --task "$task" --episodes "$DEMOS" --seed "$SEED" --scenes demo --variation "$VARIATION" --image-size "$IMAGE" \
       --compress --output "$run/demos.rec" 2>> "$run/demos.log"
   fi
-  keyframe --seed "$SEED" --output "$run/replay.rec.tmp" "$run/demos.rec" 2>> "$run/demos.log"
+  keyframe --seed "$SEED" $NET_OPTIONS --output "$run/replay.rec.tmp" "$run/demos.rec" 2>> "$run/demos.log"
   mv "$run/replay.rec.tmp" "$run/replay.rec"
   demos_ticks=$(( $(shell_ticks) - before ))
 fi
@@ -291,7 +294,7 @@ fi
 rm -f "$run/actor.done"
 qattn-train --follow --resume --stop-file "$run/actor.done" --replay-ratio "$RATIO" --pretrain "$PRETRAIN" \
   --start-after "$START_AFTER" --steps 1000000 --checkpoint-every "$CHECKPOINT_EVERY" --keep 4 \
-  --architecture "$ARCH" --batch "$BATCH" --tree-target "$TARGET_K" $target_branching --n-step "$N_STEP" --seed "$SEED" --threads "$LEARNER_THREADS" \
+  --architecture "$ARCH" $NET_OPTIONS --batch "$BATCH" --tree-target "$TARGET_K" $target_branching --n-step "$N_STEP" --seed "$SEED" --threads "$LEARNER_THREADS" \
   --checkpoint-dir "$run/ckpt" --metrics "$run/train.csv" "${inputs[@]}" 2>> "$run/train.log" &
 learner=$!
 trap 'kill_tree $(jobs -p)' EXIT  # the learner and the actors, with every program they started
