@@ -44,8 +44,8 @@ static cli::Usage usage() {
       "the gripper open. After each step the outcome comes from a person at the terminal (s "
       "success, f failure, Enter go on; q stops), from a file (--outcomes), or from a command "
       "(--judge CMD: 'CMD reset' before each episode, 'CMD outcome' after each step printing "
-      "success, failure [reason] or continue; QTE_TASK, QTE_SEED, QTE_EPISODE, QTE_STEP, "
-      "QTE_MOTION and QTE_FRAME in its environment). An episode ends on success, on failure, or "
+      "success, failure [reason] or continue; QTE_TASK, QTE_VARIATION, QTE_SEED, QTE_EPISODE, "
+      "QTE_STEP, QTE_EPISODE_LENGTH, QTE_MOTION and QTE_FRAME in its environment, /dev/null as its input). An episode ends on success, on failure, or "
       "after --episode-length steps. With --task, episodes start by themselves as in sim-step "
       "(--episodes, chunks behind --gate); the reset records carry the scene seed a stand-in "
       "world can rebuild the scene from.",
@@ -114,7 +114,7 @@ static void run(const cli::Arguments& args) {
   options.workspace = workspace_from(args);
   options.speed_fraction = args.real("speed", 0.01, 1.0);
   options.rate_hz = args.real("rate", 1, 1000);
-  options.settle_s = args.real("settle", 0, 10);
+  options.settle_s = args.real("settle", 0.01, 10);  // the gripper row needs a time of its own
   options.episode_length = args.has("episode-length") ? static_cast<int>(args.integer("episode-length", 1, 1000))
                            : plan ? tasks::make_task(plan->task)->episode_length()
                                   : 10;

@@ -3,6 +3,8 @@
 #include <dirent.h>
 #include <fcntl.h>
 #include <signal.h>
+
+#include <atomic>
 #include <sys/stat.h>
 #include <sys/syscall.h>
 #include <unistd.h>
@@ -52,7 +54,11 @@ char g_note_path[4096];
 char g_note_text[256];
 volatile sig_atomic_t g_note_set = 0;
 
+// The hook call_on_fatal_signal() asked for, called first.
+void (*volatile g_hook)() = nullptr;
+
 void remove_temp_files_and_die(int signal_number) {
+  if (g_hook) g_hook();
   if (g_note_set) {
     const int fd = ::open(g_note_path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (fd >= 0) {
@@ -87,6 +93,7 @@ int register_temp(const std::string& path, TempKind kind = kFile) {
   for (int i = 0; i < kMaxTempFiles; ++i)
     if (g_temp_kind[i] == kFree && path.size() < sizeof g_temp_paths[i]) {
       std::memcpy(g_temp_paths[i], path.c_str(), path.size() + 1);
+      std::atomic_signal_fence(std::memory_order_release);  // the path before the handler may see it
       g_temp_kind[i] = kind;
       return i;
     }
@@ -108,6 +115,11 @@ void write_on_fatal_signal(const std::string& path, const std::string& text) {
   std::memcpy(g_note_path, path.c_str(), path.size() + 1);
   std::memcpy(g_note_text, text.c_str(), text.size() + 1);
   g_note_set = 1;
+}
+
+void call_on_fatal_signal(void (*hook)()) {
+  std::call_once(g_handlers_installed, install_handlers);
+  g_hook = hook;
 }
 
 RemovedOnSignal::RemovedOnSignal(std::string path) : path_(std::move(path)) { register_temp(path_); }

@@ -76,6 +76,10 @@ class OutputDirectory {
 // halts when the program driving it is interrupted. One such file per process; the last call wins.
 void write_on_fatal_signal(const std::string& path, const std::string& text);
 
+// `hook` (async-signal-safe calls only) runs first when SIGINT, SIGTERM or SIGHUP ends the
+// process: robot-step's terminal put back out of raw mode. One hook per process; null for none.
+void call_on_fatal_signal(void (*hook)());
+
 // While it lives, `path` is removed if SIGINT, SIGTERM or SIGHUP ends the process: a request
 // that must not outlive the program waiting for its answer (robot-step's motions).
 class RemovedOnSignal {

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <fstream>
 
+#include "common/atomic_file.hpp"
 #include "common/error.hpp"
 
 namespace qte::robot_step {
@@ -28,6 +29,13 @@ Verdict parse_verdict(const std::string& line, const std::string& what) {
 }
 
 namespace {
+
+// The terminal a person judges at while it is in raw mode, for a fatal signal to put back.
+volatile int g_raw_terminal = -1;
+termios g_saved_terminal{};
+void restore_terminal() {
+  if (g_raw_terminal >= 0) ::tcsetattr(g_raw_terminal, TCSANOW, &g_saved_terminal);
+}
 
 class PersonJudge : public Judge {
  public:
@@ -65,7 +73,9 @@ class PersonJudge : public Judge {
   void say(const std::string& text) {
     if (::write(fd_, text.data(), text.size()) < 0) throw Error(terminal_ + ": cannot be written to");
   }
-  // One key press, without waiting for Enter or echoing it (the terminal's mode restored after).
+  // One key pressed after the prompt, without waiting for Enter or echoing it: keys typed
+  // before are discarded (an early Enter must not start the arm's move home). The terminal's
+  // mode is restored after, and by a fatal signal meanwhile.
   char read_key() {
     termios saved{};
     const bool is_terminal = ::tcgetattr(fd_, &saved) == 0;
@@ -73,11 +83,17 @@ class PersonJudge : public Judge {
       termios raw = saved;
       raw.c_lflag &= ~static_cast<tcflag_t>(ICANON | ECHO);
       raw.c_cc[VMIN] = 1, raw.c_cc[VTIME] = 0;
-      ::tcsetattr(fd_, TCSANOW, &raw);
+      g_saved_terminal = saved;
+      g_raw_terminal = fd_;
+      call_on_fatal_signal(restore_terminal);
+      ::tcsetattr(fd_, TCSAFLUSH, &raw);  // TCSAFLUSH: the keys typed ahead are dropped
     }
     char key = 0;
     const ssize_t n = ::read(fd_, &key, 1);
-    if (is_terminal) ::tcsetattr(fd_, TCSANOW, &saved);
+    if (is_terminal) {
+      ::tcsetattr(fd_, TCSANOW, &saved);
+      g_raw_terminal = -1;
+    }
     if (n != 1) throw Error(terminal_ + ": closed while waiting for the person's key");
     return key;
   }
@@ -136,7 +152,8 @@ class CommandJudge : public Judge {
   }
   // Runs `command word` by /bin/sh; its standard output, or Error when it fails.
   std::string run(const std::string& word) {
-    const std::string line = command_ + " " + word;
+    // Its input is not ours (the trajectories' stream): a judge that reads must not take them.
+    const std::string line = command_ + " " + word + " < /dev/null";
     std::fflush(nullptr);
     FILE* pipe = ::popen(line.c_str(), "r");
     if (!pipe) throw Error("the judge command '" + line + "' could not be started");

@@ -161,6 +161,12 @@ std::string RobotWorld::check_motion(const stream::Record& record, std::vector<r
   } catch (const Error& e) {
     return std::string("invalid_trajectory:") + e.what();
   }
+  if (rows.back().time_s > robot::JointPathLimits().max_duration_s) {  // the drivers' limit too
+    char longer[96];
+    std::snprintf(longer, sizeof longer, "invalid_trajectory:longer than %g s at --speed, with its gripper row",
+                  robot::JointPathLimits().max_duration_s);
+    return longer;
+  }
   for (const robot::XarmRow& row : rows) {
     const Eigen::Vector3d p = (world_from_base_ * robot_.tcp_pose(row.degrees * (M_PI / 180.0))).translation();
     if (!options_.workspace.contains(p)) {

@@ -126,30 +126,48 @@ MotionAnswer Spool::move(const std::vector<robot::XarmRow>& rows, const std::str
   }
   const std::string name = claim("motion");
   const std::string csv = robot::xarm_csv(rows, comment);
-  write_file_atomically(path(name + ".xarm.csv"), csv.data(), csv.size());
-  const RemovedOnSignal pending(path(name + ".xarm.csv"));  // an interrupted wait withdraws it
-  const std::size_t which = wait_for({name + ".done", name + ".fault"}, motion_timeout_, path(name + ".xarm.csv"));
-  const std::string answer = path(name + (which == 0 ? ".done" : ".fault"));
-  if (which == 0) return parse_done(read_all(answer), answer);
-  MotionAnswer fault;
-  fault.fault = first_line(read_all(answer));
-  if (fault.fault.empty()) fault.fault = "the driver reported a fault without saying which";
-  return fault;
+  // An interrupt from here on withdraws the request (the handler writes `stop`, then removes it).
+  const RemovedOnSignal pending(path(name + ".xarm.csv"));
+  return stopping_on_error([&] {
+    write_file_atomically(path(name + ".xarm.csv"), csv.data(), csv.size());
+    const std::size_t which = wait_for({name + ".done", name + ".fault"}, motion_timeout_, path(name + ".xarm.csv"));
+    const std::string answer = path(name + (which == 0 ? ".done" : ".fault"));
+    if (which == 0) return parse_done(read_all(answer), answer);
+    MotionAnswer fault;
+    fault.fault = first_line(read_all(answer));
+    if (fault.fault.empty()) fault.fault = "the driver reported a fault without saying which";
+    return fault;
+  });
 }
 
 CaptureAnswer Spool::capture() {
   const std::string name = claim("capture");
-  write_file_atomically(path(name + ".request"), "", 0);
-  const std::size_t which = wait_for({name + ".ready", name + ".fault"}, capture_timeout_, path(name + ".request"));
-  CaptureAnswer answer;
-  if (which == 1) {
-    answer.fault = first_line(read_all(path(name + ".fault")));
-    if (answer.fault.empty()) answer.fault = "the recorder reported a fault without saying which";
+  const RemovedOnSignal pending(path(name + ".request"));
+  return stopping_on_error([&] {
+    write_file_atomically(path(name + ".request"), "", 0);
+    const std::size_t which = wait_for({name + ".ready", name + ".fault"}, capture_timeout_, path(name + ".request"));
+    CaptureAnswer answer;
+    if (which == 1) {
+      answer.fault = first_line(read_all(path(name + ".fault")));
+      if (answer.fault.empty()) answer.fault = "the recorder reported a fault without saying which";
+      return answer;
+    }
+    answer.colour_png = path(name + ".color.png");
+    answer.depth_png = path(name + ".depth.png");
     return answer;
+  });
+}
+
+template <class F>
+auto Spool::stopping_on_error(F&& exchange) -> decltype(exchange()) {
+  try {
+    return exchange();
+  } catch (const std::exception& e) {
+    // Whatever went wrong (a garbled answer, a file system error), the drivers stop with us.
+    if (!stopped()) stop(std::string("robot-step stopped: ") + e.what());
+    else withdraw();
+    throw;
   }
-  answer.colour_png = path(name + ".color.png");
-  answer.depth_png = path(name + ".depth.png");
-  return answer;
 }
 
 }  // namespace qte::robot_step

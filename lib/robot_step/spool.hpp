@@ -35,8 +35,8 @@ class Spool {
   Spool(std::string directory, long session, std::chrono::milliseconds motion_timeout,
         std::chrono::milliseconds capture_timeout, std::function<std::string()> should_stop);
 
-  // Writes the motion and waits for the driver's answer. A malformed answer, a timeout or a
-  // stop writes `stop` and throws Error naming the file.
+  // Writes the motion and waits for the driver's answer. A malformed answer, a timeout, a stop
+  // or any other error writes `stop` (withdrawing the motion) and throws Error naming the file.
   MotionAnswer move(const std::vector<robot::XarmRow>& rows, const std::string& comment);
   CaptureAnswer capture();
 
@@ -50,7 +50,10 @@ class Spool {
 
  private:
   std::string claim(const std::string& kind);
-  void withdraw();  // removes the last request if it has no answer  // the next request name not used in the directory
+  void withdraw();  // removes the last request if it has no answer
+  // Runs one request's exchange; any error writes `stop` (withdrawing the request) first.
+  template <class F>
+  auto stopping_on_error(F&& exchange) -> decltype(exchange());  // the next request name not used in the directory
   // Waits until one of `names` exists; returns its index. Throws after `timeout` or on a stop.
   std::size_t wait_for(const std::vector<std::string>& names, std::chrono::milliseconds timeout,
                        const std::string& what);

@@ -234,6 +234,8 @@ class FakeRobot(threading.Thread):
             self.silent = True
         elif how.startswith("fault:"):
             put(self.spool, stem + ".fault", how[len("fault:"):] + "\n")
+        elif how.startswith("raw:"):  # an answer as a faulty driver might write it
+            put(self.spool, stem + ".done", how[len("raw:"):] + "\n")
         else:
             degrees = rows[-1, 1:8] + self.offset_deg
             gripper = self.GRIPPER_REPORTED.get(int(rows[-1, 8]), int(rows[-1, 8]))
@@ -616,6 +618,22 @@ for case, step_key in (("person", b"s"), ("person_quits", b"q")):
         check(terminal.name in person.error_line() and "stopped by the person" in person.error_line(),
               f"person_quits: the error line does not name the terminal {terminal.name}: {person.stderr[-1:]}")
 
+# Keys typed before a prompt are not its answer: an early Enter must not start the move home.
+spool = p("spool_typed_ahead")
+robot = FakeRobot(spool)
+terminal = Terminal()
+os.write(terminal.master, b"\r\r")
+early = RobotStep("typed_ahead", spool, [reset_record, *steps], "--terminal", terminal.name)
+check(wait_until(lambda: "press Enter" in terminal.text), f"typed_ahead: no reset prompt: {terminal.text!r}")
+time.sleep(0.5)
+check(not motion_files(spool), "typed_ahead: an Enter typed before the prompt started the move home")
+terminal.answer("press Enter", b"\r")
+terminal.answer("s = success", b"s")
+early.end()
+robot.end()
+terminal.close()
+early.expect_exit(0, "Enter and s pressed after their prompts")
+
 # === 6. a judge command ==============================================================================
 spool = p("spool_judge")
 log = p("judge.log")
@@ -707,6 +725,21 @@ for case, options, names in (
     line = maybe.error_line()
     check(all(n in line for n in names) and "expected success, failure [reason] or continue" in line and "maybe" in line,
           f"{case}: the error line {line!r} does not name {names} and what was expected")
+
+# === 9. a driver's answer robot-step cannot read, and settings the drivers would refuse =============
+spool = p("spool_garbled")
+robot = FakeRobot(spool, motions=["done", "raw:0,-20,0,43,0,63,0,851"])  # a gripper past open
+garbled = RobotStep("garbled", spool, [reset_record, *steps], "--outcomes", outcomes_file("garbled.txt", "continue"))
+garbled.end()
+robot.end()
+garbled.expect_exit(1, "a .done robot-step cannot read")
+check(os.path.exists(os.path.join(spool, "stop")), "garbled: an unreadable answer did not write stop")
+check("0 to 850" in garbled.error_line() and garbled.request("motion", 2) in garbled.error_line(),
+      f"garbled: the error line {garbled.error_line()!r} does not name the answer and what was expected")
+settle = subprocess.run([os.path.join(TOOLS, "robot-step"), "--spool", p("spool_settle"), *CAMERA, "--settle", "0"],
+                        input=b"", capture_output=True)
+check(settle.returncode == 2 and b"--settle" in settle.stderr,
+      f"--settle 0 (a gripper row at the motion's last time, which drivers refuse): exit {settle.returncode}, {settle.stderr!r}")
 
 if failures:
     print("\n".join("FAIL: " + f for f in failures))
