@@ -9,8 +9,10 @@ Watches the spool for capture-<session>-<n>.request and answers each, in the ord
 wrote them, with capture-...-n.color.png (8-bit RGB), capture-...-n.depth.png (16-bit greyscale,
 the depth aligned to the colour image, in the camera's depth unit: 1 mm for the D400 series as
 they start) and last capture-...-n.ready (empty), each written whole under a '.' name and
-renamed. A frame that cannot be taken is answered with capture-...-n.fault, one line. `stop` in
-the spool, SIGINT or SIGTERM end it without answering anything more.
+renamed. A frame that cannot be taken, for whatever error, is answered with capture-...-n.fault,
+one line (the error in words). `stop` in the spool, SIGINT or SIGTERM end it without answering
+anything more; a signal, or an error outside a capture, also writes `stop` in the spool saying
+why, so that robot-step stops at once instead of waiting for the frame.
 
 With Intel's Python wrapper (pip install pyrealsense2; not a dependency of the toolkit) and
 NumPy. The aligned depth has the colour stream's pixels, so robot-step's --intrinsics are the
@@ -158,8 +160,8 @@ def main():
     def handle(stem, name):
         try:
             taken = camera.answer(spool, stem)
-        except (OSError, RuntimeError) as e:
-            words = " ".join(str(e).split()) or type(e).__name__
+        except Exception as e:  # noqa: BLE001 - the camera's, the file system's, or a fault of this program
+            words = robot_spool.in_words(e, (OSError, RuntimeError))
             print(f"{name}: fault: {words}", flush=True)
             spool.answer(name, stem, "fault", words)
             return

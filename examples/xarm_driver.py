@@ -17,9 +17,18 @@ one line: the file's fault naming its line (nothing moved) or the controller's e
 in words (the arm left stopped where it is). A controller error left by a fault is cleared
 before the next motion, which robot-step sends only after the scene was reset.
 
-`stop` in the spool is checked before each motion and between streamed rows: the arm is stopped
-at once (emergency_stop) and the driver exits without answering anything more (status 0).
-SIGINT or SIGTERM do the same (status 130).
+The slow moves (the first row, the gripper) are commanded without the SDK's waiting and watched
+every 20 ms; `stop` in the spool is checked then, before each motion and between streamed rows:
+the arm is stopped at once (emergency_stop; the gripper held where it is) and the driver exits
+without answering anything more (status 0). SIGINT (Ctrl-C) or SIGTERM do the same (status 130)
+and write `stop` in the spool, saying why, so that robot-step stops at once and withdraws the
+request left unanswered (a driver started again beside `stop` exits at once: a person looks
+first). An error of any other kind while a motion is executed is answered with its .fault (the
+error's type and words) and the arm is left stopped; one outside a motion (the spool, or the
+arm not answering even the stop) ends the driver after it has stopped the arm and written
+`stop`, saying why. The gripper's position in a .done is a whole number of units in 0..850 (a
+gripper may report 851 open), and a motion after which the arm does not come to rest within
+5 s is answered with a .fault, not with joints still moving.
 
 --dry-run imports no SDK: it checks each file, prints one line per motion (rows, duration, start
 and end joints, gripper) and answers .done as a perfect arm would: the last row's joints and
@@ -61,9 +70,28 @@ class PerfectArm:
         self.gripper = position
         return 0
 
+    # What play() watches during the slow moves: the perfect arm is there at once.
+    def get_servo_angle(self, **_):
+        return 0, list(self.angles)
+
+    def get_gripper_position(self, **_):
+        return 0, self.gripper
+
+    def get_is_moving(self):
+        return False
+
+    def get_err_warn_code(self, **_):
+        return 0, [0, 0]
+
+    def emergency_stop(self):
+        return 0
+
 
 def numbers(joints, gripper):
-    return ",".join(f"{q:.6f}" for q in joints) + f",{int(round(gripper))}"
+    """The .done line: joints in degrees, the gripper a whole number of units in 0..850 (a real
+    gripper reports 851 open, and robot-step refuses a value out of range)."""
+    units = min(max(int(round(gripper)), 0), xarm_play.GRIPPER_OPEN_UNITS)
+    return ",".join(f"{q:.6f}" for q in joints) + f",{units}"
 
 
 class Driver:
@@ -113,36 +141,29 @@ class Driver:
             if self.fault_left:
                 clear(self.arm)
                 self.fault_left = False
-            code, angles = self.arm.get_servo_angle(is_radian=False)
-            xarm_play.check(self.arm, code, "get_servo_angle")
-            far = self.away_from_start(rows, list(angles)[:7])
+            far = self.away_from_start(rows, xarm_play.joints_deg(self.arm))
             if far:
                 self.spool.answer(name, stem, "fault", far)
                 return
             xarm_play.play(self.arm, rows, self.spool.stopped)
             wait_until_still(self.arm, self.spool.stopped)
-            error, _ = error_codes(self.arm)
+            error, _ = xarm_play.error_codes(self.arm)
             if error:  # an error raised after the last command was taken (a late collision)
                 raise xarm_play.ArmFault(xarm_play.controller_state(self.arm))
-            code, angles = self.arm.get_servo_angle(is_radian=False)
-            xarm_play.check(self.arm, code, "get_servo_angle")
-            code, gripper = self.arm.get_gripper_position()
-            xarm_play.check(self.arm, code, "get_gripper_position")
-        except xarm_play.Stopped:
-            self.arm.emergency_stop()
+            angles = xarm_play.joints_deg(self.arm)
+            gripper = xarm_play.gripper_units(self.arm)
+        except xarm_play.Stopped:  # the arm was stopped at once; nothing more is answered
             return
-        except (xarm_play.ArmFault, OSError, RuntimeError) as e:  # the SDK's or the network's
-            self.arm.set_state(4)  # stopped where it is
+        except Exception as e:  # noqa: BLE001 - the SDK's, the network's, or a fault of this program
+            # Stopped where it is before anything else; if even that fails, the driver ends
+            # (Spool.serve writes `stop`, main stops the arm).
+            self.arm.set_state(4)
             self.fault_left = True
-            print(f"{name}: fault: {e}", flush=True)
-            self.spool.answer(name, stem, "fault", " ".join(str(e).split()) or type(e).__name__)
+            words = robot_spool.in_words(e, xarm_play.ArmFault)
+            print(f"{name}: fault: {words}", flush=True)
+            self.spool.answer(name, stem, "fault", words)
             return
-        self.spool.answer(name, stem, "done", numbers(list(angles)[:7], gripper))
-
-
-def error_codes(arm):
-    code, codes = arm.get_err_warn_code()
-    return (codes[0], codes[1]) if code == 0 else (arm.error_code, arm.warn_code)
+        self.spool.answer(name, stem, "done", numbers(angles, gripper))
 
 
 def clear(arm):
@@ -157,13 +178,17 @@ def clear(arm):
 
 
 def wait_until_still(arm, stopped, timeout_s=5.0):
-    """The motion has ended once the arm no longer moves (the last servo row takes a moment)."""
+    """The motion has ended once the arm no longer moves (the last servo row takes a moment); an
+    arm still moving after timeout_s is a fault, not a motion done."""
     deadline = time.monotonic() + timeout_s
     time.sleep(0.05)
-    while arm.get_is_moving() and time.monotonic() < deadline:
+    while arm.get_is_moving():
         if stopped():
-            raise xarm_play.Stopped()
-        time.sleep(0.02)
+            xarm_play.stop_now(arm)
+        if time.monotonic() > deadline:
+            raise xarm_play.ArmFault(f"the arm did not come to rest within {timeout_s:g} s of the motion's last row; "
+                                     f"{xarm_play.controller_state(arm)}")
+        time.sleep(xarm_play.POLL_S)
 
 
 def main():
@@ -183,13 +208,11 @@ def main():
         arm = xarm_play.connect(args.ip)
         arm.set_mode(0)
         arm.set_state(0)
-    status = 0
     try:
         status = spool.serve(Driver(spool, arm, args.dry_run, args.pace, args.start_tolerance).handle, "xarm_driver")
     finally:
-        if arm is not None:
-            if spool.stopped():
-                arm.emergency_stop()
+        if arm is not None:  # however the driver ends (stop, a signal, an error), the arm stands still
+            arm.emergency_stop()
             arm.disconnect()
     sys.exit(status)
 

@@ -14,15 +14,20 @@ row to row (1 % slack for the printed decimals); an error names the file and lin
 
 Each file's first row is reached slowly in position mode (set_servo_angle, 20 deg/s), then the
 rows are streamed in servo mode (mode 1, set_servo_angle_j) at the file's own times; the gripper
-is moved (set_gripper_position, waiting) whenever its column changes. A file of one row is a move
-to that row, reached slowly. Keep a hand on the emergency stop: the planner saw only what the
-camera saw.
+is moved (set_gripper_position) whenever its column changes. A file of one row is a move to that
+row, reached slowly. The slow moves are commanded without the SDK's waiting and watched every
+20 ms (the arm's joints, motion and error codes; the gripper's position), so a stop is seen at
+once during them as between streamed rows: Ctrl-C (or SIGTERM) stops the arm with the SDK's
+emergency_stop, holds the gripper where it is, and ends the program (status 130). Keep a hand on
+the emergency stop all the same: the planner saw only what the camera saw.
 
 This file is the one home for reading and playing the files: examples/xarm_driver.py imports
 read_moves and play from it.
 """
 import argparse
+import inspect
 import math
+import signal
 import sys
 import time
 
@@ -39,6 +44,12 @@ LIMIT_SLACK_DEG = 1e-4      # the file's 6 decimals of a degree around a limit
 MAX_DURATION_S = 60.0
 GRIPPER_OPEN_UNITS = 850
 REACH_SPEED_DEG_S = 20      # how fast the first row is reached in position mode
+POLL_S = 0.02               # how often a slow move is watched (and a stop looked for)
+REACHED_DEG = 0.5           # a position-mode move has ended once the arm is still within this of its row
+STALLED_S = 0.5             # ... and has failed once it stands this long elsewhere
+GRIPPER_REACHED_UNITS = 1   # the gripper is there within this (the SDK's own test)
+GRIPPER_STALLED_S = 1.0     # a gripper that has not moved for this long holds something: it is done
+GRIPPER_TIMEOUT_S = 10.0    # the SDK's own wait for the gripper
 
 
 class MotionFileError(ValueError):
@@ -46,7 +57,7 @@ class MotionFileError(ValueError):
 
 
 class Stopped(Exception):
-    """play() saw its stop test come true between rows."""
+    """play() saw its stop test come true; the arm has been stopped (emergency_stop)."""
 
 
 def read_moves(path):
@@ -157,17 +168,111 @@ def controller_state(arm):
     return "; ".join(words)
 
 
+def error_codes(arm):
+    """The controller's (error, warning) codes as it reports them now."""
+    code, codes = arm.get_err_warn_code()
+    return (codes[0], codes[1]) if code == 0 else (getattr(arm, "error_code", 0), getattr(arm, "warn_code", 0))
+
+
+def joints_deg(arm):
+    """The arm's 7 joint angles in degrees, as it reports them."""
+    code, angles = arm.get_servo_angle(is_radian=False)
+    check(arm, code, "get_servo_angle")
+    return [float(q) for q in list(angles)[:7]]
+
+
+def gripper_units(arm):
+    """The gripper's position in its units, as it reports it. (The SDK answers a bare code, not
+    a pair, when the gripper has a fault.)"""
+    answer = arm.get_gripper_position()
+    code, position = answer if isinstance(answer, (tuple, list)) else (answer, None)
+    check(arm, code, "get_gripper_position")
+    if position is None:
+        raise ArmFault(f"get_gripper_position gave no position; {controller_state(arm)}")
+    return float(position)
+
+
+def stop_now(arm):
+    """Stops the arm where it is, at once."""
+    arm.emergency_stop()
+    raise Stopped()
+
+
+def reach(arm, target_deg, stopped):
+    """Moves the arm to `target_deg` slowly in position mode, watching it every POLL_S: a stop
+    stops it at once (Stopped); a controller error, an arm standing still away from the row or a
+    move far longer than its speed allows is an ArmFault (the caller stops the arm)."""
+    check(arm, arm.set_servo_angle(angle=target_deg, speed=REACH_SPEED_DEG_S, is_radian=False, wait=False),
+          "set_servo_angle")
+    start = time.monotonic()
+    distance = max(abs(a - b) for a, b in zip(joints_deg(arm), target_deg))
+    deadline = start + 2 * distance / REACH_SPEED_DEG_S + 5.0  # its speed's time, with its accelerations and more
+    still_since = None
+    while True:
+        if stopped():
+            stop_now(arm)
+        error, _ = error_codes(arm)
+        if error:
+            raise ArmFault(f"set_servo_angle: {controller_state(arm)}")
+        now = time.monotonic()
+        if arm.get_is_moving():
+            still_since = None
+        else:
+            off = max(abs(a - b) for a, b in zip(joints_deg(arm), target_deg))
+            if off <= REACHED_DEG:
+                return
+            still_since = still_since or now
+            if now - still_since > STALLED_S:  # not started, or stopped short
+                raise ArmFault(f"the arm stands {off:.1f} deg from the row it was sent to; {controller_state(arm)}")
+        if now > deadline:
+            raise ArmFault(f"the arm did not reach the row it was sent to in {now - start:.0f} s; "
+                           f"{controller_state(arm)}")
+        time.sleep(POLL_S)
+
+
+def move_gripper(arm, target, stopped):
+    """Moves the gripper to `target` units, watching it every POLL_S until it is there or stands
+    still (it holds something). A stop holds it where it is and stops the arm (Stopped)."""
+    command = {"wait": False}
+    parameters = inspect.signature(arm.set_gripper_position).parameters.values()
+    if any(p.name == "wait_motion" or p.kind == p.VAR_KEYWORD for p in parameters):
+        command["wait_motion"] = False  # newer SDKs would first wait for the arm, unwatched
+    check(arm, arm.set_gripper_position(target, **command), "set_gripper_position")
+    start = last_move = time.monotonic()
+    last = None
+    while True:
+        if stopped():
+            try:
+                arm.set_gripper_position(gripper_units(arm), **command)  # hold it where it is
+            finally:
+                stop_now(arm)
+        position = gripper_units(arm)
+        now = time.monotonic()
+        if abs(position - target) <= GRIPPER_REACHED_UNITS:
+            return
+        if last is None or abs(position - last) >= 1:
+            last, last_move = position, now
+        elif now - last_move > GRIPPER_STALLED_S:
+            return
+        if now - start > GRIPPER_TIMEOUT_S:
+            raise ArmFault(f"the gripper did not reach {target} in {GRIPPER_TIMEOUT_S:g} s (at {position:g}); "
+                           f"{controller_state(arm)}")
+        time.sleep(POLL_S)
+
+
 def play(arm, rows, stopped=lambda: False, pace=1.0):
     """Executes checked rows on an XArmAPI (or anything with its methods). stopped() is asked
-    before the motion and between streamed rows; when it is true, Stopped is raised and the
-    caller stops the arm. pace scales the rows' times (0: no waiting, for a dry run's stand-in)."""
+    before the motion, every POLL_S during the slow moves (the first row, the gripper) and
+    between streamed rows; when it is true, the arm is stopped at once (emergency_stop, the
+    gripper held where it is) and Stopped is raised. pace scales the rows' times (0: no waiting,
+    for a dry run's stand-in)."""
     _, first, gripper = rows[0]
     if stopped():
-        raise Stopped()
+        stop_now(arm)
     arm.set_mode(0)  # position mode: reach the first row slowly
     arm.set_state(0)
-    check(arm, arm.set_servo_angle(angle=first, speed=REACH_SPEED_DEG_S, is_radian=False, wait=True), "set_servo_angle")
-    check(arm, arm.set_gripper_position(gripper, wait=True), "set_gripper_position")
+    reach(arm, first, stopped)
+    move_gripper(arm, gripper, stopped)
     if len(rows) == 1:
         return
     arm.set_mode(1)  # servo mode: stream the rows
@@ -176,12 +281,12 @@ def play(arm, rows, stopped=lambda: False, pace=1.0):
     start = time.monotonic()
     for t, angles, g in rows:
         if stopped():
-            raise Stopped()
+            stop_now(arm)
         delay = start + t * pace - time.monotonic()
         if delay > 0:
             time.sleep(delay)
         if g != gripper:
-            check(arm, arm.set_gripper_position(g, wait=True), "set_gripper_position")
+            move_gripper(arm, g, stopped)
             gripper = g
             start = time.monotonic() - t * pace  # the gripper's wait shifts the remaining rows
         check(arm, arm.set_servo_angle_j(angles=angles, is_radian=False), "set_servo_angle_j")
@@ -214,16 +319,32 @@ def main():
             print(f"{path}: {describe(rows)}")
         return
     arm = connect(args.ip)
+    interrupted = []
+    for signum in (signal.SIGINT, signal.SIGTERM):  # seen within POLL_S, and the arm stopped
+        signal.signal(signum, lambda number, frame: interrupted.append(signal.Signals(number).name))
+    stopped = False
     try:
         for path, rows in moves:
             print(f"playing {path}", file=sys.stderr)
             try:
-                play(arm, rows)
+                play(arm, rows, lambda: bool(interrupted))
+            except Stopped:
+                stopped = True
+                print(f"{path}: {interrupted[0]}: the arm was stopped (emergency_stop)", file=sys.stderr)
+                sys.exit(130)
             except ArmFault as e:
+                arm.set_state(4)  # stopped where it is
+                stopped = True
                 sys.exit(f"{path}: {e}")
+    except BaseException:
+        if not stopped:
+            arm.emergency_stop()
+            stopped = True
+        raise
     finally:
-        arm.set_mode(0)
-        arm.set_state(0)
+        if not stopped:
+            arm.set_mode(0)
+            arm.set_state(0)
         arm.disconnect()
 
 
