@@ -8,6 +8,7 @@
 #include <string>
 
 #include "common/error.hpp"
+#include "nets/conv3d.hpp"
 
 namespace qte::nets {
 namespace {
@@ -32,8 +33,9 @@ torch::Tensor leaky(const torch::Tensor& x) {
 Conv3d replicate_conv3(int in, int out) {
   return Conv3d(Conv3dOptions(in, out, 3).padding(1).padding_mode(torch::kReplicate));
 }
-Conv3d conv3(int in, int out) { return Conv3d(Conv3dOptions(in, out, 3).padding(1)); }
-Conv3d conv1(int in, int out) { return Conv3d(Conv3dOptions(in, out, 1)); }
+// Zero-padded convolutions train with the swapped weight gradient (nets/conv3d.hpp).
+Conv3dLayer conv3(int in, int out) { return Conv3dLayer(Conv3dOptions(in, out, 3).padding(1)); }
+Conv3dLayer conv1(int in, int out) { return Conv3dLayer(Conv3dOptions(in, out, 1)); }
 
 // Builds a Sequential one layer per call, in order: the arguments of a single call are
 // constructed in an unspecified order (GCC goes right to left), which would make the initial
@@ -246,7 +248,7 @@ class LightNet : public QAttentionModule {
   }
 
  private:
-  Conv3d input{nullptr}, lateral2{nullptr}, up1{nullptr}, lateral1{nullptr}, up0{nullptr}, q{nullptr};
+  Conv3dLayer input{nullptr}, lateral2{nullptr}, up1{nullptr}, lateral1{nullptr}, up0{nullptr}, q{nullptr};
   Linear proprio{nullptr};
   Sequential down1{nullptr}, down2{nullptr}, head{nullptr};
 };
