@@ -1,105 +1,18 @@
 #include "nets/conv3d.hpp"
 
-#include <oneapi/dnnl/dnnl.hpp>
-
-#include <array>
 #include <atomic>
-#include <cstring>
-#include <map>
-#include <memory>
-#include <mutex>
 
 #include "common/error.hpp"
+#include "nets/onednn.hpp"
 
 namespace qte::nets {
 namespace {
 
-using dnnl::memory;
-using Dims = memory::dims;
-
 std::atomic<bool> swapped_on{true};
 
-const dnnl::engine& cpu_engine() {
-  static const dnnl::engine engine(dnnl::engine::kind::cpu, 0);
-  return engine;
-}
-
-// One shape's swapped convolution, its reorders in (the tensors as LibTorch holds them, viewed
-// with batch and channels swapped) and out (the gradient in LibTorch's [O, I, k, k, k]).
-struct SwappedConvolution {
-  bool vectorised = false;
-  memory::desc x_swapped, dy_swapped, dw_torch;
-  dnnl::convolution_forward::primitive_desc pd;
-  dnnl::convolution_forward convolution;
-  dnnl::reorder x_in, dy_in, dw_out;
-};
-
-// Shape key: N, I, D, H, W of x; O, D', H', W' of dy; padding.
-using Key = std::array<int64_t, 10>;
-
-std::shared_ptr<const SwappedConvolution> make_swapped(const Key& key) {
-  const auto [n, i, d, h, w, o, a, b, c, p] = key;
-  const auto f32 = memory::data_type::f32;
-  auto s = std::make_shared<SwappedConvolution>();
-  const int64_t x_volume = d * h * w, dy_volume = a * b * c;
-  const Dims kernel{d + 2 * p - a + 1, h + 2 * p - b + 1, w + 2 * p - c + 1};
-  const int64_t k_volume = kernel[0] * kernel[1] * kernel[2];
-  s->x_swapped = memory::desc({i, n, d, h, w}, f32, Dims{x_volume, i * x_volume, h * w, w, 1});
-  s->dy_swapped = memory::desc({o, n, a, b, c}, f32, Dims{dy_volume, o * dy_volume, b * c, c, 1});
-  s->dw_torch = memory::desc({i, o, kernel[0], kernel[1], kernel[2]}, f32,
-                             Dims{k_volume, i * k_volume, kernel[1] * kernel[2], kernel[2], 1});
-  const auto any = memory::format_tag::any;
-  const dnnl::convolution_forward::desc desc(
-      dnnl::prop_kind::forward_inference, dnnl::algorithm::convolution_direct, memory::desc({i, n, d, h, w}, f32, any),
-      memory::desc({o, n, a, b, c}, f32, any), memory::desc({i, o, kernel[0], kernel[1], kernel[2]}, f32, any),
-      Dims{1, 1, 1}, Dims{p, p, p}, Dims{p, p, p});
-  s->pd = dnnl::convolution_forward::primitive_desc(desc, cpu_engine());
-  s->vectorised = std::strncmp(s->pd.impl_info_str(), "jit", 3) == 0;
-  s->convolution = dnnl::convolution_forward(s->pd);
-  s->x_in = dnnl::reorder(dnnl::reorder::primitive_desc(cpu_engine(), s->x_swapped, cpu_engine(), s->pd.src_desc()));
-  s->dy_in =
-      dnnl::reorder(dnnl::reorder::primitive_desc(cpu_engine(), s->dy_swapped, cpu_engine(), s->pd.weights_desc()));
-  s->dw_out = dnnl::reorder(dnnl::reorder::primitive_desc(cpu_engine(), s->pd.dst_desc(), cpu_engine(), s->dw_torch));
-  return s;
-}
-
-// Created once per shape (a network has a handful) and shared by the threads that train.
-std::shared_ptr<const SwappedConvolution> swapped_for(const torch::Tensor& x, const torch::Tensor& dy,
-                                                      int64_t padding) {
-  if (x.dim() != 5 || dy.dim() != 5 || x.size(0) != dy.size(0))
-    throw Error("conv3d weight gradient: x and dy must be [N, C, D, H, W] of one batch");
-  const Key key{x.size(0), x.size(1), x.size(2), x.size(3), x.size(4), dy.size(1), dy.size(2), dy.size(3), dy.size(4),
-                padding};
-  static std::mutex mutex;
-  static std::map<Key, std::shared_ptr<const SwappedConvolution>> cache;
-  const std::lock_guard<std::mutex> lock(mutex);
-  auto& entry = cache[key];
-  if (!entry) entry = make_swapped(key);
-  return entry;
-}
-
-torch::Tensor scratch_for(const memory::desc& desc) {
-  return torch::empty({static_cast<int64_t>((desc.get_size() + 3) / 4)}, torch::kFloat);
-}
-
-torch::Tensor swapped_weight_gradient(const SwappedConvolution& s, const torch::Tensor& x, const torch::Tensor& dy) {
-  const auto& engine = cpu_engine();
-  dnnl::stream stream(engine);
-  const auto x_buffer = scratch_for(s.pd.src_desc()), dy_buffer = scratch_for(s.pd.weights_desc()),
-             dw_buffer = scratch_for(s.pd.dst_desc());
-  auto dw = torch::empty({s.dw_torch.dims()[1], s.dw_torch.dims()[0], s.dw_torch.dims()[2], s.dw_torch.dims()[3],
-                          s.dw_torch.dims()[4]},
-                         torch::kFloat);
-  memory x_torch(s.x_swapped, engine, x.data_ptr()), x_blocked(s.pd.src_desc(), engine, x_buffer.data_ptr());
-  memory dy_torch(s.dy_swapped, engine, dy.data_ptr()), dy_blocked(s.pd.weights_desc(), engine, dy_buffer.data_ptr());
-  memory dw_blocked(s.pd.dst_desc(), engine, dw_buffer.data_ptr()), dw_torch(s.dw_torch, engine, dw.data_ptr());
-  s.x_in.execute(stream, x_torch, x_blocked);
-  s.dy_in.execute(stream, dy_torch, dy_blocked);
-  s.convolution.execute(stream,
-                        {{DNNL_ARG_SRC, x_blocked}, {DNNL_ARG_WEIGHTS, dy_blocked}, {DNNL_ARG_DST, dw_blocked}});
-  s.dw_out.execute(stream, dw_blocked, dw_torch);
-  stream.wait();
-  return dw;
+// The tensors as LibTorch holds them (contiguous [N, C, D, H, W]).
+dnnl::memory::desc plain(const torch::Tensor& t) {
+  return dnnl::memory::desc(t.sizes().vec(), dnnl::memory::data_type::f32, dnnl::memory::format_tag::ncdhw);
 }
 
 // The convolution as LibTorch computes it forward, with the swapped weight gradient backward.
@@ -124,10 +37,9 @@ struct Conv3dFunction : torch::autograd::Function<Conv3dFunction> {
     };
     torch::Tensor dx, dw, db;
     if (ctx->needs_input_grad(0)) dx = std::get<0>(torch_backward(true, false));
-    if (ctx->needs_input_grad(1)) {
-      const auto swapped = swapped_for(x, dy, p);
-      dw = swapped->vectorised ? swapped_weight_gradient(*swapped, x, dy) : std::get<1>(torch_backward(false, true));
-    }
+    if (ctx->needs_input_grad(1))
+      dw = onednn::weight_gradient_vectorised(plain(x), plain(dy), p) ? conv3d_weight_gradient(x, dy, p)
+                                                                        : std::get<1>(torch_backward(false, true));
     if (ctx->needs_input_grad(2)) db = dy.sum({0, 2, 3, 4});
     return {dx, dw, db, torch::Tensor()};
   }
@@ -159,8 +71,10 @@ torch::Tensor Conv3dLayerImpl::forward(const torch::Tensor& input) {
 torch::Tensor conv3d_weight_gradient(const torch::Tensor& x, const torch::Tensor& dy, int64_t padding) {
   if (x.scalar_type() != torch::kFloat || dy.scalar_type() != torch::kFloat)
     throw Error("conv3d weight gradient: float tensors expected");
+  if (x.dim() != 5 || dy.dim() != 5 || x.size(0) != dy.size(0))
+    throw Error("conv3d weight gradient: x and dy must be [N, C, D, H, W] of one batch");
   const auto xc = x.contiguous(), dyc = dy.contiguous();
-  return swapped_weight_gradient(*swapped_for(xc, dyc, padding), xc, dyc);
+  return onednn::weight_gradient(onednn::over(xc, plain(xc)), onednn::over(dyc, plain(dyc)), padding);
 }
 
 void use_swapped_weight_gradient(bool on) { swapped_on = on; }

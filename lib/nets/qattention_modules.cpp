@@ -9,6 +9,7 @@
 
 #include "common/error.hpp"
 #include "nets/conv3d.hpp"
+#include "nets/light_trunk.hpp"
 
 namespace qte::nets {
 namespace {
@@ -227,7 +228,15 @@ class LightNet : public QAttentionModule {
   }
 
   Trunk trunk_batch(const torch::Tensor& grid, const torch::Tensor& proprio_in) override {
-    const auto e0 = leaky(input->forward(grid) + tiled(proprio->forward(proprio_in)));
+    const auto proprio_bias = proprio->forward(proprio_in);
+    if (onednn_trunk_in_use() && light_trunk_supported(grid, config().base_channels)) {
+      const bool last = static_cast<bool>(head);
+      std::vector<torch::Tensor> out = light_trunk(grid, proprio_bias, convolution_parameters(), last);
+      Trunk t{out[0], {}};
+      if (last) t.levels.assign(out.begin() + 1, out.end());
+      return t;
+    }
+    const auto e0 = leaky(input->forward(grid) + tiled(proprio_bias));
     const auto e1 = down1->forward(max_pool(e0));
     const auto e2 = down2->forward(max_pool(e1));
     const auto d1 = leaky(up1->forward(e1 + upsample(lateral2->forward(e2))));
@@ -237,6 +246,21 @@ class LightNet : public QAttentionModule {
     return out;
   }
   torch::Tensor dense_head_forward(const torch::Tensor& pooled) override { return head->forward(pooled); }
+
+  // Weight and bias of each convolution, in the order of nets/light_trunk.hpp.
+  std::vector<torch::Tensor> convolution_parameters() const {
+    using Conv = torch::nn::Conv3dImpl;
+    const std::vector<const Conv*> convolutions{
+        input.get(),           down1->ptr(0)->as<Conv>(), down1->ptr(2)->as<Conv>(), down2->ptr(0)->as<Conv>(),
+        down2->ptr(2)->as<Conv>(), lateral2.get(),        up1.get(),                 lateral1.get(),
+        up0.get(),             q.get()};
+    std::vector<torch::Tensor> p;
+    for (const Conv* c : convolutions) {
+      p.push_back(c->weight);
+      p.push_back(c->bias);
+    }
+    return p;
+  }
 
   int64_t multiply_accumulates() const override {
     const int64_t v = config().voxels, v0 = v * v * v, v1 = v0 / 8, v2 = v0 / 64;

@@ -10,8 +10,9 @@
 // Options: --arch light|arm, --batch B, --tree-target K, --steps N, --threads N.
 //   --compare K: instead, full steps with plain (double-DQN) and tree-expanded (K) targets
 //   interleaved step by step, so that a noisy machine hits both alike; prints the ratio.
-//   --compare-weight-gradient 1: instead, plain full steps with LibTorch's weight gradient and
-//   with the swapped one (nets/conv3d.hpp) interleaved step by step; prints the ratio.
+//   --compare-layers 1: instead, plain full steps with LibTorch's layers, with LibTorch's layers
+//   but the swapped weight gradient (nets/conv3d.hpp), and with the oneDNN trunk
+//   (nets/light_trunk.hpp, the default), interleaved step by step; prints the ratios.
 //   --every-sample-bootstraps 1: every sample its own next state (discount gamma, no shared
 //   states), the targets' worst case; by default the demonstrations' chains end and share
 //   keyframes, and the targets evaluate each next state once (the mean count is printed).
@@ -30,6 +31,7 @@
 #include "learner/targets.hpp"
 #include "machine_peak.hpp"
 #include "nets/conv3d.hpp"
+#include "nets/light_trunk.hpp"
 #include "nets/qattention_modules.hpp"
 #include "replay/replay_buffer.hpp"
 
@@ -46,7 +48,7 @@ static double median(std::vector<double> v) {
 int main(int argc, char** argv) {
   qte::nets::prepare_process_for_networks(argv);  // fair figures while other programs run
   std::string arch = "light";
-  int batch = 32, tree = 0, steps = 5, threads = 2, compare = 0, every_sample = 0, compare_gradient = 0;
+  int batch = 32, tree = 0, steps = 5, threads = 2, compare = 0, every_sample = 0, compare_layers = 0;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     if (a == "--arch") arch = argv[i + 1];
@@ -56,7 +58,7 @@ int main(int argc, char** argv) {
     else if (a == "--threads") threads = std::atoi(argv[i + 1]);
     else if (a == "--compare") compare = std::atoi(argv[i + 1]);
     else if (a == "--every-sample-bootstraps") every_sample = std::atoi(argv[i + 1]);
-    else if (a == "--compare-weight-gradient") compare_gradient = std::atoi(argv[i + 1]);
+    else if (a == "--compare-layers") compare_layers = std::atoi(argv[i + 1]);
   }
   nets::set_torch_threads(threads);
   nets::seed_torch(1);
@@ -79,33 +81,35 @@ int main(int argc, char** argv) {
   converter.finish(to_replay);
   std::printf("replay: %zu transitions, %zu frames (10 pick_and_lift demos)\n", replay.size(), replay.frame_count());
 
-  if (compare > 0 || compare_gradient) {
+  if (compare > 0 || compare_layers) {
     struct Variant {
       const char* name;
       int tree;
-      bool swapped;
+      bool swapped, onednn;
       std::unique_ptr<learner::QLearner> learner;
       std::vector<double> seconds;
     };
     std::vector<Variant> variants;
-    const auto add = [&](const char* name, int k, bool swapped) {
+    const auto add = [&](const char* name, int k, bool swapped, bool onednn) {
       learner::LearnerConfig c = config;
       c.tree_target_k = k;
       nets::seed_torch(1);
-      variants.push_back({name, k, swapped, std::make_unique<learner::QLearner>(c), {}});
+      variants.push_back({name, k, swapped, onednn, std::make_unique<learner::QLearner>(c), {}});
     };
-    if (compare_gradient) {
-      add("LibTorch's weight gradient", tree, false);
-      add("swapped weight gradient", tree, true);
+    if (compare_layers) {
+      add("LibTorch's layers", tree, false, false);
+      add("+ swapped weight gradient", tree, true, false);
+      add("oneDNN trunk", tree, true, true);
     } else {
-      add("plain targets", 0, true);
-      add("tree targets", compare, true);
+      add("plain targets", 0, true, true);
+      add("tree targets", compare, true, true);
     }
     double states = 0;  // next states the targets evaluate, summed over the timed steps
     for (int step = 0; step <= steps; ++step)  // step 0 warms up
       for (Variant& v : variants) {
         std::mt19937_64 rng(step);
         nets::use_swapped_weight_gradient(v.swapped);
+        nets::use_onednn_trunk(v.onednn);
         const auto t0 = Clock::now();
         const replay::Sample sample = replay.sample(batch, 1.0, rng);
         learner::Minibatch mb = learner::assemble_minibatch(replay, sample, config);
@@ -151,9 +155,9 @@ int main(int argc, char** argv) {
     full_s.push_back(t_sample + t_assemble + t_train);
   }
   const double full = median(full_s), targets = median(target_s), assemble = median(assemble_s);
-  std::printf("%s batch %d, %d depths, tree target K=%d, %d threads, median of %d steps, %s weight gradient:\n",
-              arch.c_str(), batch, config.hierarchy.depths, tree, threads, steps,
-              nets::swapped_weight_gradient_in_use() ? "swapped" : "LibTorch's");
+  std::printf("%s batch %d, %d depths, tree target K=%d, %d threads, median of %d steps, %s:\n", arch.c_str(), batch,
+              config.hierarchy.depths, tree, threads, steps,
+              nets::onednn_trunk_in_use() ? "oneDNN trunk where supported" : "LibTorch's layers");
   std::printf("  full step        %.3f s  (sampling %.4f, voxelizing the batch %.3f, targets %.3f, "
               "forward+backward+Adam of all depths %.3f)\n",
               full, median(sample_s), assemble, targets, full - median(sample_s) - assemble - targets);

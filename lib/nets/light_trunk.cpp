@@ -1,0 +1,454 @@
+#include "nets/light_trunk.hpp"
+
+#include <array>
+#include <atomic>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <tuple>
+
+#include "common/error.hpp"
+#include "nets/onednn.hpp"
+
+namespace qte::nets {
+namespace {
+
+using dnnl::memory;
+using Desc = memory::desc;
+using Dims = memory::dims;
+using Tag = memory::format_tag;
+using onednn::Buffer;
+using onednn::buffer;
+using onednn::engine;
+using onednn::over;
+constexpr auto f32 = memory::data_type::f32;
+constexpr float kLeakySlope = 0.02f;  // LightNet's LeakyReLU
+
+std::atomic<bool> trunk_on{true};
+
+// LightNet's convolutions, in the order of their parameters.
+enum Layer { kInput, kDown10, kDown12, kDown20, kDown22, kLateral2, kUp1, kLateral1, kUp0, kQ, kLayers };
+
+// The activations' layouts: channels in blocks of b (oneDNN's nCdhw8c or nCdhw16c), or plain
+// (b = 1); 0 for any other.
+int64_t channel_block(const Desc& d) {
+  const Dims dims = d.dims();
+  if (dims.size() != 5) return 0;
+  if (d == Desc(dims, f32, Tag::nCdhw8c)) return 8;
+  if (d == Desc(dims, f32, Tag::nCdhw16c)) return 16;
+  if (d == Desc(dims, f32, Tag::ncdhw)) return 1;
+  return 0;
+}
+
+// A buffer of layout d seen as [N, C/b, voxels, b] (channels padded to a multiple of b).
+torch::Tensor blocked_view(const torch::Tensor& storage, const Desc& d) {
+  const Dims dims = d.dims();
+  const int64_t b = channel_block(d), blocks = (dims[1] + b - 1) / b, voxels = dims[2] * dims[3] * dims[4];
+  return storage.narrow(0, 0, dims[0] * blocks * voxels * b).view({dims[0], blocks, voxels, b});
+}
+
+// Per sample and channel, the sum over the voxels: [N, C].
+torch::Tensor voxel_sums(const torch::Tensor& storage, const Desc& d) {
+  const auto sums = blocked_view(storage, d).sum(2);
+  return sums.reshape({sums.size(0), -1}).narrow(1, 0, d.dims()[1]);
+}
+
+struct Convolution {
+  int64_t padding = 0;
+  bool leaky = false;  // LeakyReLU fused as a post-op
+  dnnl::convolution_forward::primitive_desc forward_pd;
+  dnnl::convolution_forward forward;
+  dnnl::reorder weights_forward;  // LibTorch's [O, I, k, k, k] into the forward's layout
+  bool has_backward_data = false;
+  dnnl::convolution_backward_data::primitive_desc backward_pd;
+  dnnl::convolution_backward_data backward_data;
+  dnnl::reorder weights_backward;
+  dnnl::eltwise_backward leaky_backward;  // through the fused LeakyReLU, from its output
+  Desc src() const { return forward_pd.src_desc(); }
+  Desc dst() const { return forward_pd.dst_desc(); }
+};
+
+dnnl::eltwise_backward leaky_backward_for(const Desc& y) {
+  const auto algorithm = dnnl::algorithm::eltwise_relu_use_dst_for_bwd;
+  const dnnl::eltwise_forward::primitive_desc hint({dnnl::prop_kind::forward_training, algorithm, y, kLeakySlope},
+                                                   engine());
+  return dnnl::eltwise_backward(dnnl::eltwise_backward::primitive_desc({algorithm, y, y, kLeakySlope}, engine(), hint));
+}
+
+Convolution make_convolution(int64_t n, int64_t in, int64_t out, int64_t v, int64_t kernel, bool leaky,
+                             bool backward_data) {
+  Convolution c;
+  c.padding = kernel / 2, c.leaky = leaky, c.has_backward_data = backward_data;
+  const Dims strides{1, 1, 1}, pad{c.padding, c.padding, c.padding};
+  const Desc src({n, in, v, v, v}, f32, Tag::any), weights({out, in, kernel, kernel, kernel}, f32, Tag::any),
+      bias({out}, f32, Tag::x), dst({n, out, v, v, v}, f32, Tag::any);
+  const Desc torch_weights({out, in, kernel, kernel, kernel}, f32, Tag::oidhw);
+  dnnl::primitive_attr attr;
+  if (leaky) {
+    dnnl::post_ops ops;
+    ops.append_eltwise(1.f, dnnl::algorithm::eltwise_relu, kLeakySlope, 0.f);
+    attr.set_post_ops(ops);
+  }
+  c.forward_pd = dnnl::convolution_forward::primitive_desc(
+      {dnnl::prop_kind::forward_training, dnnl::algorithm::convolution_direct, src, weights, bias, dst, strides, pad, pad},
+      attr, engine());
+  c.forward = dnnl::convolution_forward(c.forward_pd);
+  c.weights_forward =
+      dnnl::reorder(dnnl::reorder::primitive_desc(engine(), torch_weights, engine(), c.forward_pd.weights_desc()));
+  if (backward_data) {
+    c.backward_pd = dnnl::convolution_backward_data::primitive_desc(
+        {dnnl::algorithm::convolution_direct, src, weights, dst, strides, pad, pad}, engine(), c.forward_pd);
+    c.backward_data = dnnl::convolution_backward_data(c.backward_pd);
+    c.weights_backward =
+        dnnl::reorder(dnnl::reorder::primitive_desc(engine(), torch_weights, engine(), c.backward_pd.weights_desc()));
+  }
+  if (leaky) c.leaky_backward = leaky_backward_for(c.dst());
+  return c;
+}
+
+struct Pooling {  // LightNet's max pooling: 3^3 windows, stride 2, padding 1
+  dnnl::pooling_v2_forward::primitive_desc forward_pd;
+  dnnl::pooling_v2_forward forward;
+  dnnl::pooling_v2_backward backward;
+};
+
+Pooling make_pooling(const Desc& src) {
+  const Dims d = src.dims();
+  const int64_t o = (d[2] - 1) / 2 + 1;
+  const Dims strides{2, 2, 2}, kernel{3, 3, 3}, dilation{0, 0, 0}, pad{1, 1, 1};
+  Pooling p;
+  p.forward_pd = dnnl::pooling_v2_forward::primitive_desc(
+      {dnnl::prop_kind::forward_training, dnnl::algorithm::pooling_max, src, Desc({d[0], d[1], o, o, o}, f32, Tag::any),
+       strides, kernel, dilation, pad, pad},
+      engine());
+  p.forward = dnnl::pooling_v2_forward(p.forward_pd);
+  p.backward = dnnl::pooling_v2_backward(dnnl::pooling_v2_backward::primitive_desc(
+      {dnnl::algorithm::pooling_max, src, p.forward_pd.dst_desc(), strides, kernel, dilation, pad, pad}, engine(),
+      p.forward_pd));
+  return p;
+}
+
+// Trilinear x2 upsampling, half-pixel centres (LibTorch's align_corners=false). Its backward is
+// LibTorch's: oneDNN 2.6 has no vectorised kernel for it (its generic one took 4-5x as long).
+struct Upsampling {
+  dnnl::resampling_forward forward;
+};
+
+Upsampling make_upsampling(const Desc& src, const Desc& dst) {
+  return {dnnl::resampling_forward(dnnl::resampling_forward::primitive_desc(
+      {dnnl::prop_kind::forward_training, dnnl::algorithm::resampling_linear, src, dst}, engine()))};
+}
+
+// Every primitive of one batch size, created once.
+struct Graph {
+  std::array<Convolution, kLayers> convolution;
+  dnnl::eltwise_forward leaky0;  // the first activation, after the proprioception's bias
+  dnnl::eltwise_backward leaky0_backward;
+  Pooling pool0, pool1;
+  Upsampling up2, up1;  // from level 2 to 1, from 1 to 0
+  Desc e0, e1, e2, grid_plain, grid;
+  bool supported = false;
+};
+
+bool vectorised(const dnnl::primitive_desc_base& pd) { return std::strncmp(pd.impl_info_str(), "jit", 3) == 0; }
+
+std::unique_ptr<Graph> make_graph(int64_t n, int64_t channels, int64_t k, int64_t v) {
+  auto g = std::make_unique<Graph>();
+  auto& c = g->convolution;
+  c[kInput] = make_convolution(n, channels, k, v, 3, false, false);
+  g->e0 = c[kInput].dst();
+  g->grid = c[kInput].src();
+  g->grid_plain = Desc({n, channels, v, v, v}, f32, Tag::ncdhw);
+  const auto leaky = dnnl::algorithm::eltwise_relu_use_dst_for_bwd;
+  g->leaky0 = dnnl::eltwise_forward(dnnl::eltwise_forward::primitive_desc(
+      {dnnl::prop_kind::forward_training, leaky, g->e0, kLeakySlope}, engine()));
+  g->leaky0_backward = leaky_backward_for(g->e0);
+  g->pool0 = make_pooling(g->e0);
+  c[kDown10] = make_convolution(n, k, 2 * k, v / 2, 3, true, true);
+  c[kDown12] = make_convolution(n, 2 * k, 2 * k, v / 2, 3, true, true);
+  g->e1 = c[kDown12].dst();
+  g->pool1 = make_pooling(g->e1);
+  c[kDown20] = make_convolution(n, 2 * k, 4 * k, v / 4, 3, true, true);
+  c[kDown22] = make_convolution(n, 4 * k, 4 * k, v / 4, 3, true, true);
+  g->e2 = c[kDown22].dst();
+  c[kLateral2] = make_convolution(n, 4 * k, 2 * k, v / 4, 1, false, true);
+  g->up2 = make_upsampling(c[kLateral2].dst(), g->e1);
+  c[kUp1] = make_convolution(n, 2 * k, 2 * k, v / 2, 3, true, true);
+  c[kLateral1] = make_convolution(n, 2 * k, k, v / 2, 1, false, true);
+  g->up1 = make_upsampling(c[kLateral1].dst(), g->e0);
+  c[kUp0] = make_convolution(n, k, k, v, 3, true, true);
+  c[kQ] = make_convolution(n, k, 1, v, 1, false, true);
+  // Each layer reads its input in the layout the one before wrote it, and its backward passes
+  // gradients in those layouts; otherwise (a layout this code does not expect) LibTorch runs it.
+  const std::array<std::pair<Desc, Desc>, 9> links{{{c[kDown10].src(), g->pool0.forward_pd.dst_desc()},
+                                                    {c[kDown12].src(), c[kDown10].dst()},
+                                                    {c[kDown20].src(), g->pool1.forward_pd.dst_desc()},
+                                                    {c[kDown22].src(), c[kDown20].dst()},
+                                                    {c[kLateral2].src(), g->e2},
+                                                    {c[kUp1].src(), g->e1},
+                                                    {c[kLateral1].src(), c[kUp1].dst()},
+                                                    {c[kUp0].src(), g->e0},
+                                                    {c[kQ].src(), c[kUp0].dst()}}};
+  bool ok = channel_block(g->e0) > 1 && k % channel_block(g->e0) == 0;
+  for (const auto& [a, b] : links) ok = ok && a == b && channel_block(a) > 0;
+  for (const Convolution& conv : c) {
+    ok = ok && vectorised(conv.forward_pd) && channel_block(conv.dst()) > 0;
+    if (conv.has_backward_data)
+      ok = ok && vectorised(conv.backward_pd) && conv.backward_pd.diff_src_desc() == conv.src() &&
+           conv.backward_pd.diff_dst_desc() == conv.dst();
+  }
+  g->supported = ok;
+  return g;
+}
+
+const Graph& graph_for(int64_t n, int64_t channels, int64_t k, int64_t v) {
+  static std::mutex mutex;
+  static std::map<std::array<int64_t, 4>, std::unique_ptr<Graph>> graphs;
+  const std::lock_guard<std::mutex> lock(mutex);
+  auto& g = graphs[{n, channels, k, v}];
+  if (!g) g = make_graph(n, channels, k, v);
+  return *g;
+}
+
+// The activations a backward needs, in the order the forward makes them.
+enum Saved { kE0, kP0, kWs0, kT1, kE1, kP1, kWs1, kT2, kE2, kS1, kD1, kS0, kD0, kSaved };
+
+struct Run {
+  const Graph& g;
+  dnnl::stream stream{engine()};
+  explicit Run(const Graph& graph) : g(graph) {}
+
+  // A layer's forward into a new buffer of its output layout.
+  Buffer convolve(Layer layer, const memory& src, const torch::Tensor& weight, const torch::Tensor& bias) {
+    const Convolution& c = g.convolution[layer];
+    Buffer w = buffer(c.forward_pd.weights_desc()), dst = buffer(c.dst());
+    memory torch_w = over(weight, Desc(weight.sizes().vec(), f32, Tag::oidhw));
+    c.weights_forward.execute(stream, torch_w, w.memory);
+    c.forward.execute(stream, {{DNNL_ARG_SRC, src},
+                               {DNNL_ARG_WEIGHTS, w.memory},
+                               {DNNL_ARG_BIAS, over(bias, c.forward_pd.bias_desc())},
+                               {DNNL_ARG_DST, dst.memory}});
+    return dst;
+  }
+  // The gradient at a layer's input from the gradient at its output (before its activation).
+  Buffer backward_data(Layer layer, const memory& diff_dst, const torch::Tensor& weight) {
+    const Convolution& c = g.convolution[layer];
+    Buffer w = buffer(c.backward_pd.weights_desc()), diff_src = buffer(c.src());
+    memory torch_w = over(weight, Desc(weight.sizes().vec(), f32, Tag::oidhw));
+    c.weights_backward.execute(stream, torch_w, w.memory);
+    c.backward_data.execute(stream,
+                            {{DNNL_ARG_DIFF_DST, diff_dst}, {DNNL_ARG_WEIGHTS, w.memory}, {DNNL_ARG_DIFF_SRC, diff_src.memory}});
+    return diff_src;
+  }
+  // Through a fused LeakyReLU, from the layer's output y.
+  Buffer through_leaky(const dnnl::eltwise_backward& leaky, const Desc& d, const memory& diff, const torch::Tensor& y) {
+    Buffer out = buffer(d);
+    leaky.execute(stream, {{DNNL_ARG_DST, over(y, d)}, {DNNL_ARG_DIFF_DST, diff}, {DNNL_ARG_DIFF_SRC, out.memory}});
+    return out;
+  }
+  Buffer sum(const Buffer& a, const torch::Tensor& b, const Desc& d) {
+    const auto s = a.storage + b;
+    return {s, over(s, d)};
+  }
+  // A plain [N, C, ...] tensor from a buffer of layout d, and back.
+  torch::Tensor to_plain(const Buffer& b, const Desc& d) {
+    auto out = torch::empty(d.dims(), torch::kFloat);
+    memory plain = over(out, Desc(d.dims(), f32, Tag::ncdhw)), src = b.memory;
+    dnnl::reorder(src, plain).execute(stream, src, plain);
+    return out;
+  }
+  // The gradient at an upsampling's input (layout `small`) from the one at its output (`large`).
+  Buffer upsampling_backward(const Buffer& diff, const Desc& large, const Desc& small) {
+    const Dims l = large.dims(), s = small.dims();
+    const auto diff_small = at::upsample_trilinear3d_backward(to_plain(diff, large), {l[2], l[3], l[4]}, s, false, 2.0,
+                                                              2.0, 2.0);
+    return from_plain(diff_small, small);
+  }
+  Buffer from_plain(const torch::Tensor& t, const Desc& d) {
+    const auto c = t.contiguous();
+    Buffer out = buffer(d);
+    memory plain = over(c, Desc(d.dims(), f32, Tag::ncdhw));
+    dnnl::reorder(plain, out.memory).execute(stream, plain, out.memory);
+    return out;
+  }
+};
+
+torch::Tensor bias_gradient(const Buffer& diff, const Desc& d) { return voxel_sums(diff.storage, d).sum(0); }
+
+struct LightTrunkFunction : torch::autograd::Function<LightTrunkFunction> {
+  static torch::autograd::variable_list forward(torch::autograd::AutogradContext* ctx, const torch::Tensor& grid,
+                                                const torch::Tensor& proprio_bias, at::TensorList parameters,
+                                                bool levels) {
+    const int64_t n = grid.size(0), k = proprio_bias.size(1);
+    const Graph& g = graph_for(n, grid.size(1), k, grid.size(2));
+    Run run(g);
+    const auto weight = [&](Layer l) { return parameters[2 * l].contiguous(); };
+    const auto bias = [&](Layer l) { return parameters[2 * l + 1].contiguous(); };
+    const auto grid_c = grid.contiguous();
+    Buffer grid_b = run.from_plain(grid_c, g.grid);
+
+    Buffer e0 = run.convolve(kInput, grid_b.memory, weight(kInput), bias(kInput));
+    blocked_view(e0.storage, g.e0).add_(proprio_bias.contiguous().view({n, -1, 1, channel_block(g.e0)}));
+    g.leaky0.execute(run.stream, {{DNNL_ARG_SRC, e0.memory}, {DNNL_ARG_DST, e0.memory}});
+    const auto pool = [&](const Pooling& p, const Buffer& src, Buffer& workspace) {
+      Buffer dst = buffer(p.forward_pd.dst_desc());
+      workspace = buffer(p.forward_pd.workspace_desc());
+      p.forward.execute(run.stream,
+                        {{DNNL_ARG_SRC, src.memory}, {DNNL_ARG_DST, dst.memory}, {DNNL_ARG_WORKSPACE, workspace.memory}});
+      return dst;
+    };
+    Buffer ws0, ws1;
+    Buffer p0 = pool(g.pool0, e0, ws0);
+    Buffer t1 = run.convolve(kDown10, p0.memory, weight(kDown10), bias(kDown10));
+    Buffer e1 = run.convolve(kDown12, t1.memory, weight(kDown12), bias(kDown12));
+    Buffer p1 = pool(g.pool1, e1, ws1);
+    Buffer t2 = run.convolve(kDown20, p1.memory, weight(kDown20), bias(kDown20));
+    Buffer e2 = run.convolve(kDown22, t2.memory, weight(kDown22), bias(kDown22));
+    const auto upsample_onto = [&](const Upsampling& up, const Buffer& small, const Buffer& skip, const Desc& d) {
+      Buffer r = buffer(d);
+      up.forward.execute(run.stream, {{DNNL_ARG_SRC, small.memory}, {DNNL_ARG_DST, r.memory}});
+      return run.sum(r, skip.storage, d);
+    };
+    Buffer l2 = run.convolve(kLateral2, e2.memory, weight(kLateral2), bias(kLateral2));
+    Buffer s1 = upsample_onto(g.up2, l2, e1, g.e1);
+    Buffer d1 = run.convolve(kUp1, s1.memory, weight(kUp1), bias(kUp1));
+    Buffer l1 = run.convolve(kLateral1, d1.memory, weight(kLateral1), bias(kLateral1));
+    Buffer s0 = upsample_onto(g.up1, l1, e0, g.e0);
+    Buffer d0 = run.convolve(kUp0, s0.memory, weight(kUp0), bias(kUp0));
+    Buffer q = run.convolve(kQ, d0.memory, weight(kQ), bias(kQ));
+
+    torch::autograd::variable_list out{run.to_plain(q, g.convolution[kQ].dst()).squeeze(1)};
+    if (levels) {
+      out.push_back(run.to_plain(e0, g.e0));
+      out.push_back(run.to_plain(e1, g.e1));
+      out.push_back(run.to_plain(e2, g.e2));
+      out.push_back(run.to_plain(d0, g.convolution[kUp0].dst()));
+    }
+    run.stream.wait();
+    {  // kept with the autograd node while its outputs live (only when an input needs gradients)
+      std::vector<torch::Tensor> saved(kSaved);
+      saved[kE0] = e0.storage, saved[kP0] = p0.storage, saved[kWs0] = ws0.storage, saved[kT1] = t1.storage;
+      saved[kE1] = e1.storage, saved[kP1] = p1.storage, saved[kWs1] = ws1.storage, saved[kT2] = t2.storage;
+      saved[kE2] = e2.storage, saved[kS1] = s1.storage, saved[kD1] = d1.storage, saved[kS0] = s0.storage;
+      saved[kD0] = d0.storage;
+      ctx->saved_data["activations"] = saved;
+      std::vector<torch::Tensor> inputs{grid_c};
+      for (const auto& p : parameters) inputs.push_back(p);
+      ctx->save_for_backward(inputs);
+      ctx->saved_data["proprio_channels"] = k;
+    }
+    return out;
+  }
+
+  static torch::autograd::variable_list backward(torch::autograd::AutogradContext* ctx,
+                                                 torch::autograd::variable_list grads) {
+    const auto inputs = ctx->get_saved_variables();
+    const auto saved = ctx->saved_data["activations"].toTensorVector();
+    const torch::Tensor& grid = inputs[0];
+    const int64_t n = grid.size(0), k = ctx->saved_data["proprio_channels"].toInt(), v = grid.size(2);
+    const Graph& g = graph_for(n, grid.size(1), k, v);
+    const auto& c = g.convolution;
+    Run run(g);
+    const auto weight = [&](Layer l) { return inputs[1 + 2 * l].contiguous(); };
+    const auto at = [&](Saved s, const Desc& d) { return over(saved[s], d); };
+    torch::autograd::variable_list out(2 + 2 * kLayers + 1);  // grid, proprio_bias, parameters, levels
+    // The weight and bias gradients of a layer from its input x and the gradient at its output.
+    const auto parameter_gradients = [&](Layer l, const memory& x, const Buffer& diff) {
+      out[2 + 2 * l] = onednn::weight_gradient(x, diff.memory, c[l].padding);
+      out[2 + 2 * l + 1] = bias_gradient(diff, c[l].dst());
+    };
+    const auto level_gradient = [&](size_t i, const Desc& d) -> torch::Tensor {
+      if (grads.size() <= i || !grads[i].defined()) return {};
+      return run.from_plain(grads[i], d).storage;
+    };
+    const auto add_level = [&](Buffer& b, size_t i, const Desc& d) {
+      const auto extra = level_gradient(i, d);
+      if (extra.defined()) b = run.sum(b, extra, d);
+    };
+
+    const Desc q_dst = c[kQ].dst(), d0_desc = c[kUp0].dst();
+    const torch::Tensor dq =
+        grads[0].defined() ? grads[0].unsqueeze(1) : torch::zeros({n, 1, v, v, v}, torch::kFloat);
+    Buffer g_q = run.from_plain(dq, q_dst);
+    Buffer g_d0 = run.backward_data(kQ, g_q.memory, weight(kQ));
+    parameter_gradients(kQ, at(kD0, d0_desc), g_q);
+    add_level(g_d0, 4, d0_desc);
+    Buffer g_u0 = run.through_leaky(c[kUp0].leaky_backward, d0_desc, g_d0.memory, saved[kD0]);
+    Buffer g_s0 = run.backward_data(kUp0, g_u0.memory, weight(kUp0));
+    parameter_gradients(kUp0, at(kS0, g.e0), g_u0);
+    Buffer g_l1 = run.upsampling_backward(g_s0, g.e0, c[kLateral1].dst());
+    Buffer g_d1 = run.backward_data(kLateral1, g_l1.memory, weight(kLateral1));
+    parameter_gradients(kLateral1, at(kD1, c[kUp1].dst()), g_l1);
+    Buffer g_u1 = run.through_leaky(c[kUp1].leaky_backward, c[kUp1].dst(), g_d1.memory, saved[kD1]);
+    Buffer g_s1 = run.backward_data(kUp1, g_u1.memory, weight(kUp1));
+    parameter_gradients(kUp1, at(kS1, g.e1), g_u1);
+    Buffer g_l2 = run.upsampling_backward(g_s1, g.e1, c[kLateral2].dst());
+    Buffer g_e2 = run.backward_data(kLateral2, g_l2.memory, weight(kLateral2));
+    parameter_gradients(kLateral2, at(kE2, g.e2), g_l2);
+    add_level(g_e2, 3, g.e2);
+    Buffer g_22 = run.through_leaky(c[kDown22].leaky_backward, g.e2, g_e2.memory, saved[kE2]);
+    Buffer g_t2 = run.backward_data(kDown22, g_22.memory, weight(kDown22));
+    parameter_gradients(kDown22, at(kT2, c[kDown20].dst()), g_22);
+    Buffer g_20 = run.through_leaky(c[kDown20].leaky_backward, c[kDown20].dst(), g_t2.memory, saved[kT2]);
+    Buffer g_p1 = run.backward_data(kDown20, g_20.memory, weight(kDown20));
+    parameter_gradients(kDown20, at(kP1, c[kDown20].src()), g_20);
+    const auto unpool = [&](const Pooling& p, const Buffer& diff_dst, Saved workspace, const Desc& src) {
+      Buffer diff_src = buffer(src);
+      p.backward.execute(run.stream, {{DNNL_ARG_DIFF_DST, diff_dst.memory},
+                                      {DNNL_ARG_WORKSPACE, at(workspace, p.forward_pd.workspace_desc())},
+                                      {DNNL_ARG_DIFF_SRC, diff_src.memory}});
+      return diff_src;
+    };
+    Buffer g_e1 = run.sum(g_s1, unpool(g.pool1, g_p1, kWs1, g.e1).storage, g.e1);
+    add_level(g_e1, 2, g.e1);
+    Buffer g_12 = run.through_leaky(c[kDown12].leaky_backward, g.e1, g_e1.memory, saved[kE1]);
+    Buffer g_t1 = run.backward_data(kDown12, g_12.memory, weight(kDown12));
+    parameter_gradients(kDown12, at(kT1, c[kDown10].dst()), g_12);
+    Buffer g_10 = run.through_leaky(c[kDown10].leaky_backward, c[kDown10].dst(), g_t1.memory, saved[kT1]);
+    Buffer g_p0 = run.backward_data(kDown10, g_10.memory, weight(kDown10));
+    parameter_gradients(kDown10, at(kP0, c[kDown10].src()), g_10);
+    Buffer g_e0 = run.sum(g_s0, unpool(g.pool0, g_p0, kWs0, g.e0).storage, g.e0);
+    add_level(g_e0, 1, g.e0);
+    Buffer g_a0 = run.through_leaky(g.leaky0_backward, g.e0, g_e0.memory, saved[kE0]);
+    run.stream.wait();
+    out[2 + 2 * kInput] = onednn::weight_gradient(over(grid, g.grid_plain), g_a0.memory, 1);
+    const auto per_sample = voxel_sums(g_a0.storage, g.e0);
+    out[2 + 2 * kInput + 1] = per_sample.sum(0);
+    out[1] = per_sample;
+    return out;
+  }
+};
+
+}  // namespace
+
+std::vector<torch::Tensor> light_trunk(const torch::Tensor& grid, const torch::Tensor& proprio_bias,
+                                       const std::vector<torch::Tensor>& parameters, bool levels) {
+  if (parameters.size() != 2 * kLayers) throw Error("light trunk: expected 20 parameters");
+  // Without gradients (acting, the learner's targets) the batch size varies from call to call,
+  // and each new size costs its primitives' creation (tens of milliseconds): batches larger than
+  // 4 run padded with zero samples to a multiple of 4, so that few sizes ever occur.
+  const int64_t n = grid.size(0), padded = n <= 4 ? n : (n + 3) / 4 * 4;
+  if (torch::GradMode::is_enabled() || padded == n)
+    return LightTrunkFunction::apply(grid, proprio_bias, at::TensorList(parameters), levels);
+  const auto pad = [&](const torch::Tensor& t) {
+    auto sizes = t.sizes().vec();
+    sizes[0] = padded - n;
+    return torch::cat({t, torch::zeros(sizes, t.options())});
+  };
+  auto out = LightTrunkFunction::apply(pad(grid), pad(proprio_bias), at::TensorList(parameters), levels);
+  for (auto& t : out) t = t.narrow(0, 0, n);
+  return out;
+}
+
+bool light_trunk_supported(const torch::Tensor& grid, int base_channels) {
+  if (grid.dim() != 5 || grid.scalar_type() != torch::kFloat || !grid.device().is_cpu() || grid.size(2) % 4 != 0 ||
+      grid.size(2) != grid.size(3) || grid.size(2) != grid.size(4))
+    return false;
+  return graph_for(grid.size(0), grid.size(1), base_channels, grid.size(2)).supported;
+}
+
+void use_onednn_trunk(bool on) { trunk_on = on; }
+bool onednn_trunk_in_use() { return trunk_on; }
+
+}  // namespace qte::nets

@@ -1,0 +1,38 @@
+// `light`'s convolutional trunk run by oneDNN alone, forward and backward.
+//
+// Run layer by layer through LibTorch, every activation is converted between LibTorch's plain
+// layout and oneDNN's blocked one around each convolution, and the activations, pooling,
+// upsampling and sums are separate passes over plain tensors. Here the activations stay in
+// oneDNN's blocked layout from the first convolution to the last: bias and LeakyReLU fused into
+// each convolution, pooling and trilinear upsampling as oneDNN primitives, the backward as
+// oneDNN's backward primitives (the weight gradients as in nets/onednn.hpp). The layers, their
+// order and their parameters are LightNet's (nets/qattention_modules.cpp); Q values and
+// gradients equal LibTorch's within fp32 rounding (tests/unit/nets/test_light_trunk.cpp).
+#pragma once
+
+#include <torch/torch.h>
+
+#include <vector>
+
+namespace qte::nets {
+
+// The trunk of a grid batch [N, C, V, V, V] (channels first) with the proprioception's per-sample
+// bias [N, k] added before the first activation, and the ten convolutions' parameters in
+// LightNet's order (input, down1.0, down1.2, down2.0, down2.2, lateral2, up1, lateral1, up0, q),
+// weight then bias of each. Returns the translation Q values [N, V, V, V] and, with `levels`,
+// the four levels the dense head pools (e0, e1, e2, d0), each [N, C_l, ...]. With gradients on,
+// the backward reaches proprio_bias and every parameter (not the grid).
+std::vector<torch::Tensor> light_trunk(const torch::Tensor& grid, const torch::Tensor& proprio_bias,
+                                       const std::vector<torch::Tensor>& parameters, bool levels);
+
+// Whether light_trunk can run these inputs here: float tensors on the CPU, V a multiple of 4,
+// and oneDNN vectorised kernels for its convolutions on this processor (chosen by oneDNN at
+// run time); LightNet uses LibTorch's layers otherwise.
+bool light_trunk_supported(const torch::Tensor& grid, int base_channels);
+
+// Whether LightNet uses light_trunk where it can (default: yes). Off, it runs LibTorch's layers;
+// the tests and benchmarks compare the two in one process.
+void use_onednn_trunk(bool on);
+bool onednn_trunk_in_use();
+
+}  // namespace qte::nets

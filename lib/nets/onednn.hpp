@@ -1,0 +1,29 @@
+// oneDNN used directly by the networks (the library LibTorch itself runs its convolutions with,
+// from Debian): one CPU engine, buffers owned by tensors, and the weight gradient of a 3D
+// convolution computed as a forward convolution (nets/conv3d.hpp says why).
+#pragma once
+
+#include <oneapi/dnnl/dnnl.hpp>
+#include <torch/torch.h>
+
+namespace qte::nets::onednn {
+
+const dnnl::engine& engine();
+
+// A oneDNN memory over a new tensor's storage (freed with the tensor).
+struct Buffer {
+  torch::Tensor storage;
+  dnnl::memory memory;
+};
+Buffer buffer(const dnnl::memory::desc& desc);
+// A memory of `desc` over an existing tensor's storage.
+dnnl::memory over(const torch::Tensor& storage, const dnnl::memory::desc& desc);
+
+// The weight gradient [O, I, k, k, k] (LibTorch's layout) of a stride-1 3D convolution padded by
+// `padding` on every side, from its input x [N, I, ...] and output gradient dy [N, O, ...], each
+// in any layout oneDNN knows.
+torch::Tensor weight_gradient(const dnnl::memory& x, const dnnl::memory& dy, int64_t padding);
+// Whether oneDNN has a vectorised kernel for that computation on this processor.
+bool weight_gradient_vectorised(const dnnl::memory::desc& x, const dnnl::memory::desc& dy, int64_t padding);
+
+}  // namespace qte::nets::onednn

@@ -1,0 +1,100 @@
+// light's trunk run by oneDNN alone (nets/light_trunk.hpp) against LibTorch's layers, through a
+// whole network: Q values, the head's levels and every parameter's gradient.
+#include <gtest/gtest.h>
+
+#include "nets/conv3d.hpp"
+#include "nets/light_trunk.hpp"
+#include "nets/qattention_modules.hpp"
+
+namespace qte::nets {
+namespace {
+
+void expect_close(const torch::Tensor& a, const torch::Tensor& b, double tolerance, const std::string& what) {
+  ASSERT_EQ(a.sizes(), b.sizes()) << what;
+  const double scale = std::max(b.abs().max().item<double>(), 1e-12);
+  EXPECT_LE((a - b).abs().max().item<double>(), tolerance * scale) << what;
+}
+
+struct Pass {
+  QOutputs out;
+  std::vector<torch::Tensor> levels, gradients;
+};
+
+// A training pass with the loss touching every output, so every parameter gets a gradient.
+Pass training_pass(QAttentionModule& net, const torch::Tensor& grid, const torch::Tensor& proprio, bool onednn) {
+  use_onednn_trunk(onednn);
+  use_swapped_weight_gradient(onednn);
+  net.zero_grad();
+  Pass pass;
+  const Trunk trunk = net.trunk(grid, proprio);
+  pass.out.translation = trunk.translation;
+  auto loss = (trunk.translation * torch::linspace(0.1, 1, trunk.translation.numel()).view(trunk.translation.sizes()))
+                  .sum();
+  if (net.config().is_last) {
+    net.heads(trunk.levels, pass.out);
+    loss = loss + pass.out.rotation.square().mean() + pass.out.gripper.square().mean();
+    for (const auto& level : trunk.levels) pass.levels.push_back(level.detach().clone());
+  }
+  loss.backward();
+  for (const auto& p : net.parameters()) pass.gradients.push_back(p.grad().clone());
+  use_onednn_trunk(true);
+  use_swapped_weight_gradient(true);
+  return pass;
+}
+
+TEST(LightTrunk, IsUsedOnAProcessorWithAvx2) {
+  if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "no AVX2: LibTorch's layers are used";
+  EXPECT_TRUE(light_trunk_supported(torch::zeros({3, 10, 16, 16, 16}), 16));
+  EXPECT_TRUE(light_trunk_supported(torch::zeros({1, 10, 8, 8, 8}), 8));
+  EXPECT_FALSE(light_trunk_supported(torch::zeros({3, 10, 16, 16, 16}, torch::kDouble), 16));
+}
+
+TEST(LightTrunk, EqualsLibTorchsLayersForwardAndBackward) {
+  if (!light_trunk_supported(torch::zeros({3, 10, 16, 16, 16}), 16)) GTEST_SKIP() << "oneDNN trunk not supported here";
+  for (const bool is_last : {false, true}) {
+    NetConfig config;
+    config.is_last = is_last;
+    config.proprio = 5;
+    torch::manual_seed(11);
+    const auto net = make_qattention_module(config);
+    const auto grid = torch::rand({3, config.channels, config.voxels, config.voxels, config.voxels});
+    const auto proprio = torch::rand({3, config.proprio});
+    const Pass theirs = training_pass(*net, grid, proprio, false), ours = training_pass(*net, grid, proprio, true),
+               again = training_pass(*net, grid, proprio, true);
+    const std::string depth = is_last ? "last depth: " : "depth 0: ";
+    expect_close(ours.out.translation, theirs.out.translation, 1e-5, depth + "Q values");
+    ASSERT_EQ(ours.levels.size(), theirs.levels.size());
+    for (size_t i = 0; i < ours.levels.size(); ++i)
+      expect_close(ours.levels[i], theirs.levels[i], 1e-5, depth + "level " + std::to_string(i));
+    if (is_last) {
+      expect_close(ours.out.rotation, theirs.out.rotation, 1e-4, depth + "rotation Q");
+      expect_close(ours.out.gripper, theirs.out.gripper, 1e-4, depth + "gripper Q");
+    }
+    ASSERT_EQ(ours.gradients.size(), theirs.gradients.size());
+    const auto names = net->named_parameters().keys();
+    for (size_t i = 0; i < ours.gradients.size(); ++i) {
+      expect_close(ours.gradients[i], theirs.gradients[i], 2e-4, depth + names[i]);
+      EXPECT_TRUE(torch::equal(ours.gradients[i], again.gradients[i])) << depth << names[i] << " repeats exactly";
+    }
+  }
+}
+
+// Without gradients a batch larger than 4 runs padded to a multiple of 4: the same values.
+TEST(LightTrunk, InferenceEqualsTheTrainingForward) {
+  NetConfig config;
+  config.is_last = true;
+  torch::manual_seed(12);
+  const auto net = make_qattention_module(config);
+  for (const int batch : {1, 3, 6}) {
+    const auto grid = torch::rand({batch, config.channels, config.voxels, config.voxels, config.voxels});
+    const auto proprio = torch::rand({batch, config.proprio});
+    const auto trained = net->forward(grid, proprio);
+    torch::NoGradGuard no_grad;
+    const auto inferred = net->forward(grid, proprio);
+    EXPECT_TRUE(torch::equal(trained.translation, inferred.translation)) << "batch " << batch;
+    EXPECT_TRUE(torch::equal(trained.rotation, inferred.rotation)) << "batch " << batch;
+  }
+}
+
+}  // namespace
+}  // namespace qte::nets
