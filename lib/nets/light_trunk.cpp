@@ -367,32 +367,14 @@ struct LightTrunkFunction : torch::autograd::Function<LightTrunkFunction> {
       if (extra.defined()) b = run.sum(b, extra, d);
     };
 
-    const Desc q_dst = c[kQ].dst(), d0_desc = c[kUp0].dst();
-    const torch::Tensor dq =
-        grads[0].defined() ? grads[0].unsqueeze(1) : torch::zeros({n, 1, v, v, v}, torch::kFloat);
-    Buffer g_q = run.from_plain(dq, q_dst);
-    Buffer g_d0 = run.backward_data(kQ, g_q.memory, weight(kQ));
-    parameter_gradients(kQ, at(kD0, d0_desc), g_q);
-    add_level(g_d0, 4, d0_desc);
-    Buffer g_u0 = run.through_leaky(c[kUp0].leaky_backward, d0_desc, g_d0.memory, saved[kD0]);
-    Buffer g_s0 = run.backward_data(kUp0, g_u0.memory, weight(kUp0));
-    parameter_gradients(kUp0, at(kS0, g.e0), g_u0);
-    Buffer g_l1 = run.upsampling_backward(g_s0, g.e0, c[kLateral1].dst());
-    Buffer g_d1 = run.backward_data(kLateral1, g_l1.memory, weight(kLateral1));
-    parameter_gradients(kLateral1, at(kD1, c[kUp1].dst()), g_l1);
-    Buffer g_u1 = run.through_leaky(c[kUp1].leaky_backward, c[kUp1].dst(), g_d1.memory, saved[kD1]);
-    Buffer g_s1 = run.backward_data(kUp1, g_u1.memory, weight(kUp1));
-    parameter_gradients(kUp1, at(kS1, g.e1), g_u1);
-    Buffer g_l2 = run.upsampling_backward(g_s1, g.e1, c[kLateral2].dst());
-    Buffer g_e2 = run.backward_data(kLateral2, g_l2.memory, weight(kLateral2));
-    parameter_gradients(kLateral2, at(kE2, g.e2), g_l2);
-    add_level(g_e2, 3, g.e2);
-    Buffer g_22 = run.through_leaky(c[kDown22].leaky_backward, g.e2, g_e2.memory, saved[kE2]);
-    Buffer g_t2 = run.backward_data(kDown22, g_22.memory, weight(kDown22));
-    parameter_gradients(kDown22, at(kT2, c[kDown20].dst()), g_22);
-    Buffer g_20 = run.through_leaky(c[kDown20].leaky_backward, c[kDown20].dst(), g_t2.memory, saved[kT2]);
-    Buffer g_p1 = run.backward_data(kDown20, g_20.memory, weight(kDown20));
-    parameter_gradients(kDown20, at(kP1, c[kDown20].src()), g_20);
+    // Back through layer l and its LeakyReLU (if it has one; `y` its output): its parameters'
+    // gradients from its input x; returns the gradient at its input.
+    const auto back_through = [&](Layer l, const Buffer& diff_y, const torch::Tensor& y, const memory& x) {
+      const Buffer diff = c[l].leaky ? run.through_leaky(c[l].leaky_backward, c[l].dst(), diff_y.memory, y) : diff_y;
+      Buffer diff_x = run.backward_data(l, diff.memory, weight(l));
+      parameter_gradients(l, x, diff);
+      return diff_x;
+    };
     const auto unpool = [&](const Pooling& p, const Buffer& diff_dst, Saved workspace, const Desc& src) {
       Buffer diff_src = buffer(src);
       p.backward.execute(run.stream, {{DNNL_ARG_DIFF_DST, diff_dst.memory},
@@ -400,14 +382,25 @@ struct LightTrunkFunction : torch::autograd::Function<LightTrunkFunction> {
                                       {DNNL_ARG_DIFF_SRC, diff_src.memory}});
       return diff_src;
     };
+
+    const Desc d0_desc = c[kUp0].dst();
+    const torch::Tensor dq =
+        grads[0].defined() ? grads[0].unsqueeze(1) : torch::zeros({n, 1, v, v, v}, torch::kFloat);
+    Buffer g_d0 = back_through(kQ, run.from_plain(dq, c[kQ].dst()), {}, at(kD0, d0_desc));
+    add_level(g_d0, 4, d0_desc);
+    const Buffer g_s0 = back_through(kUp0, g_d0, saved[kD0], at(kS0, g.e0));
+    const Buffer g_d1 = back_through(kLateral1, run.upsampling_backward(g_s0, g.e0, c[kLateral1].dst()), {},
+                                     at(kD1, c[kUp1].dst()));
+    const Buffer g_s1 = back_through(kUp1, g_d1, saved[kD1], at(kS1, g.e1));
+    Buffer g_e2 = back_through(kLateral2, run.upsampling_backward(g_s1, g.e1, c[kLateral2].dst()), {},
+                               at(kE2, g.e2));
+    add_level(g_e2, 3, g.e2);
+    const Buffer g_t2 = back_through(kDown22, g_e2, saved[kE2], at(kT2, c[kDown20].dst()));
+    const Buffer g_p1 = back_through(kDown20, g_t2, saved[kT2], at(kP1, c[kDown20].src()));
     Buffer g_e1 = run.sum(g_s1, unpool(g.pool1, g_p1, kWs1, g.e1).storage, g.e1);
     add_level(g_e1, 2, g.e1);
-    Buffer g_12 = run.through_leaky(c[kDown12].leaky_backward, g.e1, g_e1.memory, saved[kE1]);
-    Buffer g_t1 = run.backward_data(kDown12, g_12.memory, weight(kDown12));
-    parameter_gradients(kDown12, at(kT1, c[kDown10].dst()), g_12);
-    Buffer g_10 = run.through_leaky(c[kDown10].leaky_backward, c[kDown10].dst(), g_t1.memory, saved[kT1]);
-    Buffer g_p0 = run.backward_data(kDown10, g_10.memory, weight(kDown10));
-    parameter_gradients(kDown10, at(kP0, c[kDown10].src()), g_10);
+    const Buffer g_t1 = back_through(kDown12, g_e1, saved[kE1], at(kT1, c[kDown10].dst()));
+    const Buffer g_p0 = back_through(kDown10, g_t1, saved[kT1], at(kP0, c[kDown10].src()));
     Buffer g_e0 = run.sum(g_s0, unpool(g.pool0, g_p0, kWs0, g.e0).storage, g.e0);
     add_level(g_e0, 1, g.e0);
     Buffer g_a0 = run.through_leaky(g.leaky0_backward, g.e0, g_e0.memory, saved[kE0]);
