@@ -8,7 +8,7 @@
 namespace qte::nets {
 namespace {
 
-std::atomic<bool> swapped_on{true};
+std::atomic<int> swapped_on{-1};  // -1: as onednn::layers_by_default()
 
 // The tensors as LibTorch holds them (contiguous [N, C, D, H, W]).
 dnnl::memory::desc plain(const torch::Tensor& t) {
@@ -60,7 +60,7 @@ int64_t plain_padding(const torch::nn::detail::ConvNdOptions<3>& o) {
 torch::Tensor Conv3dLayerImpl::forward(const torch::Tensor& input) {
   const auto& o = options;
   const int64_t padding = plain_padding(o);
-  const bool swappable = swapped_on && torch::GradMode::is_enabled() && weight.requires_grad() && bias.defined() &&
+  const bool swappable = swapped_weight_gradient_in_use() && torch::GradMode::is_enabled() && weight.requires_grad() && bias.defined() &&
                          padding >= 0 && all_ones(o.stride()) && all_ones(o.dilation()) && o.groups() == 1 &&
                          !o.transposed() && input.scalar_type() == torch::kFloat && input.device().is_cpu() &&
                          weight.scalar_type() == torch::kFloat;
@@ -78,6 +78,6 @@ torch::Tensor conv3d_weight_gradient(const torch::Tensor& x, const torch::Tensor
 }
 
 void use_swapped_weight_gradient(bool on) { swapped_on = on; }
-bool swapped_weight_gradient_in_use() { return swapped_on; }
+bool swapped_weight_gradient_in_use() { return swapped_on < 0 ? onednn::layers_by_default() : swapped_on == 1; }
 
 }  // namespace qte::nets

@@ -33,8 +33,8 @@ TORCH_MODULE(Conv3dLayer);
 // x [N, I, D, H, W] and output gradient dy [N, O, D', H', W']: [O, I, k, k, k].
 torch::Tensor conv3d_weight_gradient(const torch::Tensor& x, const torch::Tensor& dy, int64_t padding);
 
-// Whether Conv3dLayer's backward uses conv3d_weight_gradient (default: yes, where oneDNN has a
-// vectorised kernel for it on this processor). Off, it is LibTorch's backward throughout; the
+// Whether Conv3dLayer's backward uses conv3d_weight_gradient (default: onednn::layers_by_default(),
+// and only where oneDNN has a vectorised kernel for it on this processor). Off, it is LibTorch's backward throughout; the
 // benchmarks and tests compare the two in one process.
 void use_swapped_weight_gradient(bool on);
 bool swapped_weight_gradient_in_use();

@@ -25,7 +25,7 @@ using onednn::over;
 constexpr auto f32 = memory::data_type::f32;
 constexpr float kLeakySlope = 0.02f;  // LightNet's LeakyReLU
 
-std::atomic<bool> trunk_on{true};
+std::atomic<int> trunk_on{-1};  // -1: as onednn::layers_by_default()
 
 // LightNet's convolutions, in the order of their parameters.
 enum Layer { kInput, kDown10, kDown12, kDown20, kDown22, kLateral2, kUp1, kLateral1, kUp0, kQ, kLayers };
@@ -442,6 +442,6 @@ bool light_trunk_supported(const torch::Tensor& grid, int base_channels) {
 }
 
 void use_onednn_trunk(bool on) { trunk_on = on; }
-bool onednn_trunk_in_use() { return trunk_on; }
+bool onednn_trunk_in_use() { return trunk_on < 0 ? onednn::layers_by_default() : trunk_on == 1; }
 
 }  // namespace qte::nets

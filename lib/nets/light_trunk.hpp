@@ -31,8 +31,8 @@ std::vector<torch::Tensor> light_trunk(const torch::Tensor& grid, const torch::T
 // run time); LightNet uses LibTorch's layers otherwise.
 bool light_trunk_supported(const torch::Tensor& grid, int base_channels);
 
-// Whether LightNet uses light_trunk where it can (default: yes). Off, it runs LibTorch's layers;
-// the tests and benchmarks compare the two in one process.
+// Whether LightNet uses light_trunk where it can (default: onednn::layers_by_default()). Off,
+// it runs LibTorch's layers; the tests and benchmarks compare the two in one process.
 void use_onednn_trunk(bool on);
 bool onednn_trunk_in_use();
 

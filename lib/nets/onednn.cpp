@@ -1,9 +1,13 @@
 #include "nets/onednn.hpp"
 
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <mutex>
+#include <string>
 #include <vector>
+
+#include "common/error.hpp"
 
 namespace qte::nets::onednn {
 namespace {
@@ -63,6 +67,16 @@ const Swapped& swapped(const memory::desc& x, const memory::desc& dy, int64_t pa
 }
 
 }  // namespace
+
+bool layers_by_default() {
+  static const bool onednn = [] {
+    const char* value = std::getenv("QTE_NETWORK_LAYERS");
+    if (!value || std::strcmp(value, "onednn") == 0) return true;
+    if (std::strcmp(value, "libtorch") == 0) return false;
+    throw Error(std::string("QTE_NETWORK_LAYERS must be libtorch or onednn, got '") + value + "'");
+  }();
+  return onednn;
+}
 
 const dnnl::engine& engine() {
   static const dnnl::engine cpu(dnnl::engine::kind::cpu, 0);

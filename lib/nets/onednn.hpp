@@ -10,6 +10,12 @@ namespace qte::nets::onednn {
 
 const dnnl::engine& engine();
 
+// Whether the networks' layers use oneDNN directly (nets/conv3d.hpp, nets/light_trunk.hpp)
+// unless a program says otherwise: yes, unless the environment variable QTE_NETWORK_LAYERS is
+// `libtorch` (LibTorch's layers throughout: a comparison kept on one implementation, such as a
+// campaign begun with it). Any other value than `libtorch` or `onednn` is an Error.
+bool layers_by_default();
+
 // A oneDNN memory over a new tensor's storage (freed with the tensor).
 struct Buffer {
   torch::Tensor storage;

@@ -35,6 +35,22 @@ grep -q "resumed at step 3" "$tmp/b.log" || fail "$(cat "$tmp/b.log")"
 cmp -s "$tmp/a/latest.rec" "$tmp/b/latest.rec" || fail "a resumed run differs from an uninterrupted one"
 [ "$(cut -d, -f1 "$tmp/b.csv" | tr '\n' ' ')" = "step 2 3 4 6 " ] || fail "resumed metrics: $(cat "$tmp/b.csv")"
 
+# The networks' layers: LibTorch's throughout with QTE_NETWORK_LAYERS=libtorch, the same bytes
+# run after run; on a processor where oneDNN runs them (AVX2), other bytes than oneDNN's (the
+# same sums in another order); any other value refused.
+train --steps 4 --checkpoint-dir "$tmp/on" "$tmp/tr.rec" 2>/dev/null || fail "default layers"
+for d in lt lt2; do
+  QTE_NETWORK_LAYERS=libtorch train --steps 4 --checkpoint-dir "$tmp/$d" "$tmp/tr.rec" 2>/dev/null \
+    || fail "QTE_NETWORK_LAYERS=libtorch"
+done
+cmp -s "$tmp/lt/latest.rec" "$tmp/lt2/latest.rec" || fail "LibTorch's layers: two runs differ"
+if grep -qw avx2 /proc/cpuinfo; then
+  cmp -s "$tmp/on/latest.rec" "$tmp/lt/latest.rec" && fail "QTE_NETWORK_LAYERS=libtorch made no difference"
+fi
+err=$(QTE_NETWORK_LAYERS=fast train --steps 4 --checkpoint-dir "$tmp/bad" "$tmp/tr.rec" 2>&1) \
+  && fail "QTE_NETWORK_LAYERS=fast accepted"
+grep -q "QTE_NETWORK_LAYERS must be libtorch or onednn, got 'fast'" <<<"$err" || fail "$err"
+
 # Another seed or thread count would resume as another run: refused.
 err=$(qattn-train --batch 4 --start-after 4 --seed 6 --steps 6 --checkpoint-every 3 --checkpoint-dir "$tmp/b" --resume \
   "$tmp/tr.rec" 2>&1) \
