@@ -6,10 +6,10 @@
 #include <map>
 #include <memory>
 #include <mutex>
-#include <tuple>
 
 #include "common/error.hpp"
 #include "nets/onednn.hpp"
+#include "nets/qattention_modules.hpp"
 
 namespace qte::nets {
 namespace {
@@ -23,7 +23,7 @@ using onednn::buffer;
 using onednn::engine;
 using onednn::over;
 constexpr auto f32 = memory::data_type::f32;
-constexpr float kLeakySlope = 0.02f;  // LightNet's LeakyReLU
+constexpr float kLeaky = static_cast<float>(kLeakySlope);  // LightNet's LeakyReLU
 
 std::atomic<int> trunk_on{-1};  // -1: as onednn::layers_by_default()
 
@@ -71,9 +71,9 @@ struct Convolution {
 
 dnnl::eltwise_backward leaky_backward_for(const Desc& y) {
   const auto algorithm = dnnl::algorithm::eltwise_relu_use_dst_for_bwd;
-  const dnnl::eltwise_forward::primitive_desc hint({dnnl::prop_kind::forward_training, algorithm, y, kLeakySlope},
+  const dnnl::eltwise_forward::primitive_desc hint({dnnl::prop_kind::forward_training, algorithm, y, kLeaky},
                                                    engine());
-  return dnnl::eltwise_backward(dnnl::eltwise_backward::primitive_desc({algorithm, y, y, kLeakySlope}, engine(), hint));
+  return dnnl::eltwise_backward(dnnl::eltwise_backward::primitive_desc({algorithm, y, y, kLeaky}, engine(), hint));
 }
 
 Convolution make_convolution(int64_t n, int64_t in, int64_t out, int64_t v, int64_t kernel, bool leaky,
@@ -87,7 +87,7 @@ Convolution make_convolution(int64_t n, int64_t in, int64_t out, int64_t v, int6
   dnnl::primitive_attr attr;
   if (leaky) {
     dnnl::post_ops ops;
-    ops.append_eltwise(1.f, dnnl::algorithm::eltwise_relu, kLeakySlope, 0.f);
+    ops.append_eltwise(1.f, dnnl::algorithm::eltwise_relu, kLeaky, 0.f);
     attr.set_post_ops(ops);
   }
   c.forward_pd = dnnl::convolution_forward::primitive_desc(
@@ -162,7 +162,7 @@ std::unique_ptr<Graph> make_graph(int64_t n, int64_t channels, int64_t k, int64_
   g->grid_plain = Desc({n, channels, v, v, v}, f32, Tag::ncdhw);
   const auto leaky = dnnl::algorithm::eltwise_relu_use_dst_for_bwd;
   g->leaky0 = dnnl::eltwise_forward(dnnl::eltwise_forward::primitive_desc(
-      {dnnl::prop_kind::forward_training, leaky, g->e0, kLeakySlope}, engine()));
+      {dnnl::prop_kind::forward_training, leaky, g->e0, kLeaky}, engine()));
   g->leaky0_backward = leaky_backward_for(g->e0);
   g->pool0 = make_pooling(g->e0);
   c[kDown10] = make_convolution(n, k, 2 * k, v / 2, 3, true, true);

@@ -21,7 +21,6 @@ using torch::nn::LeakyReLU;
 using torch::nn::Linear;
 using torch::nn::Sequential;
 
-constexpr double kLeakySlope = 0.02;
 constexpr double kSoftArgmaxTemperature = 0.01;
 constexpr int kHeadHidden = 128;
 

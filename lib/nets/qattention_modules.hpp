@@ -11,6 +11,9 @@
 
 namespace qte::nets {
 
+// The networks' LeakyReLU slope (the reference's), in LibTorch's layers and oneDNN's alike.
+constexpr double kLeakySlope = 0.02;
+
 struct QOutputs {
   torch::Tensor translation;  // [B, V, V, V]
   torch::Tensor rotation;     // [B, 3, 72]; undefined unless the config is_last

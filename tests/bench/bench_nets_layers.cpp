@@ -53,11 +53,6 @@ std::vector<Layer> light_layers() {
           {"head.4 linear", 128, qte::nets::kRotationAxes * qte::nets::kRotationBins + qte::nets::kGripperActions, 0, 1}};
 }
 
-const std::vector<Layer>& light_layers_cache() {
-  static const std::vector<Layer> layers = light_layers();
-  return layers;
-}
-
 torch::nn::AnyModule make(const Layer& l) {
   if (l.kernel == 0) return torch::nn::AnyModule(torch::nn::Linear(l.in, l.out));
   return torch::nn::AnyModule(
@@ -100,11 +95,12 @@ void run(int threads, int reps, int batch) {
   const auto share = [&](double gflops) { return 100 * gflops / peak.gflops; };
   Totals total;
   double total_gflop = 0, total_bwd_gflop = 0, total_torch_backward = 0;
-  for (const Layer& l : light_layers_cache()) {
+  const std::vector<Layer> layers = light_layers();
+  for (const Layer& l : layers) {
     torch::nn::AnyModule m = make(l);
     auto parameters = m.ptr()->parameters();
     torch::optim::Adam adam(parameters, torch::optim::AdamOptions(1e-4));
-    const bool first = &l == &light_layers_cache().front();
+    const bool first = &l == &layers.front();  // its input is the grid: no input gradient
     const torch::Tensor x = input_for(l, batch).requires_grad_(!first);
     torch::Tensor y;
     const double fwd = seconds(reps, [&] { y = m.forward(x); });
