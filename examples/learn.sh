@@ -292,6 +292,9 @@ if [ "$ROLE" = learner ]; then
   for ((i = 0; i < ACTORS; i++)); do touch "$run/actors/replay-$i.rec"; inputs+=("$run/actors/replay-$i.rec"); done
 fi
 rm -f "$run/actor.done"
+# Pretraining happens in this process tree if the learner starts before step PRETRAIN (it may
+# be over before the first checkpoint is seen).
+pretraining=$(( $(newest_checkpoint_step "$run/ckpt") < PRETRAIN ))
 qattn-train --follow --resume --stop-file "$run/actor.done" --replay-ratio "$RATIO" --pretrain "$PRETRAIN" \
   --start-after "$START_AFTER" --steps 1000000 --checkpoint-every "$CHECKPOINT_EVERY" --keep 4 \
   --architecture "$ARCH" $NET_OPTIONS --batch "$BATCH" --tree-target "$TARGET_K" $target_branching --n-step "$N_STEP" --seed "$SEED" --threads "$LEARNER_THREADS" \
@@ -302,7 +305,6 @@ while [ ! -f "$run/ckpt/latest.rec" ]; do check_learner; nap 0.5; done
 
 # The learner's newest step, from its checkpoint names.
 learner_step() { newest_checkpoint_step "$run/ckpt"; }
-pretraining=$(( $(learner_step) < PRETRAIN ))  # pretraining happens in this process tree
 # Waits until the learner has taken the steps the replay ratio allows for `agent` transitions.
 # The gradient steps the replay ratio allows after N agent transitions: what
 # `qattn-train --steps-allowed N` prints (a test holds the two equal), without the second it
