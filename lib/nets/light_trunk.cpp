@@ -1,5 +1,8 @@
 #include "nets/light_trunk.hpp"
 
+#include <ATen/Parallel.h>
+
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cstring>
@@ -130,7 +133,8 @@ Pooling make_pooling(const Desc& src) {
 }
 
 // Trilinear x2 upsampling, half-pixel centres (LibTorch's align_corners=false). Its backward is
-// LibTorch's: oneDNN 2.6 has no vectorised kernel for it (its generic one took 4-5x as long).
+// ours (upsampling_adjoint): oneDNN 2.6 has no vectorised kernel for it (its generic one took
+// 4-5x as long as LibTorch's, which needs the plain layout).
 struct Upsampling {
   dnnl::resampling_forward forward;
 };
@@ -138,6 +142,39 @@ struct Upsampling {
 Upsampling make_upsampling(const Desc& src, const Desc& dst) {
   return {dnnl::resampling_forward(dnnl::resampling_forward::primitive_desc(
       {dnnl::prop_kind::forward_training, dnnl::algorithm::resampling_linear, src, dst}, engine()))};
+}
+
+// The adjoint of x2 linear upsampling along one axis of x [outer, 2 * small, inner] into
+// y [outer, small, inner]: output sample l sits at (l + 0.5) / 2 - 0.5 in the input, so y[s]
+// gets x[2s] and x[2s + 1] with weight 3/4 and their outer neighbours x[2s - 1] and x[2s + 2]
+// with 1/4; at the ends the edge sample takes the whole weight (the clamped indices below).
+void upsampling_adjoint_axis(const float* x, float* y, int64_t outer, int64_t small, int64_t inner) {
+  const int64_t large = 2 * small;
+  at::parallel_for(0, outer, 1, [&](int64_t begin, int64_t end) {
+    for (int64_t o = begin; o < end; ++o)
+      for (int64_t s = 0; s < small; ++s) {
+        const float* xo = x + o * large * inner;
+        const float* a = xo + std::max<int64_t>(2 * s - 1, 0) * inner;
+        const float* b = xo + 2 * s * inner;
+        const float* c = b + inner;
+        const float* d = xo + std::min<int64_t>(2 * s + 2, large - 1) * inner;
+        float* out = y + (o * small + s) * inner;
+        for (int64_t i = 0; i < inner; ++i) out[i] = 0.75f * (b[i] + c[i]) + 0.25f * (a[i] + d[i]);
+      }
+  });
+}
+
+// The gradient at a trilinear x2 upsampling's input from the one at its output, both in one
+// channel-blocked layout [N, C/b, D, H, W, b]: the 1D adjoint along W, then H, then D (the
+// trilinear weights are the product of the three axes' weights).
+void upsampling_adjoint(const float* large, float* small, const Dims& small_dims, int64_t block) {
+  const int64_t planes = small_dims[0] * ((small_dims[1] + block - 1) / block);
+  const int64_t d = small_dims[2], h = small_dims[3], w = small_dims[4];
+  std::vector<float> along_w(static_cast<size_t>(planes * 2 * d * 2 * h * w * block));
+  std::vector<float> along_h(static_cast<size_t>(planes * 2 * d * h * w * block));
+  upsampling_adjoint_axis(large, along_w.data(), planes * 2 * d * 2 * h, w, block);
+  upsampling_adjoint_axis(along_w.data(), along_h.data(), planes * 2 * d, h, w * block);
+  upsampling_adjoint_axis(along_h.data(), small, planes, d, h * w * block);
 }
 
 // Every primitive of one batch size, created once.
@@ -190,7 +227,9 @@ std::unique_ptr<Graph> make_graph(int64_t n, int64_t channels, int64_t k, int64_
                                                     {c[kLateral1].src(), c[kUp1].dst()},
                                                     {c[kUp0].src(), g->e0},
                                                     {c[kQ].src(), c[kUp0].dst()}}};
-  bool ok = channel_block(g->e0) > 1 && k % channel_block(g->e0) == 0;
+  bool ok = channel_block(g->e0) > 1 && k % channel_block(g->e0) == 0 &&
+            channel_block(c[kLateral2].dst()) == channel_block(g->e1) &&
+            channel_block(c[kLateral1].dst()) == channel_block(g->e0);
   for (const auto& [a, b] : links) ok = ok && a == b && channel_block(a) > 0;
   for (const Convolution& conv : c) {
     ok = ok && vectorised(conv.forward_pd) && channel_block(conv.dst()) > 0;
@@ -247,10 +286,6 @@ struct Run {
     leaky.execute(stream, {{DNNL_ARG_DST, over(y, d)}, {DNNL_ARG_DIFF_DST, diff}, {DNNL_ARG_DIFF_SRC, out.memory}});
     return out;
   }
-  Buffer sum(const Buffer& a, const torch::Tensor& b, const Desc& d) {
-    const auto s = a.storage + b;
-    return {s, over(s, d)};
-  }
   // A plain [N, C, ...] tensor from a buffer of layout d, and back.
   torch::Tensor to_plain(const Buffer& b, const Desc& d) {
     auto out = torch::empty(d.dims(), torch::kFloat);
@@ -258,12 +293,13 @@ struct Run {
     dnnl::reorder(src, plain).execute(stream, src, plain);
     return out;
   }
-  // The gradient at an upsampling's input (layout `small`) from the one at its output (`large`).
-  Buffer upsampling_backward(const Buffer& diff, const Desc& large, const Desc& small) {
-    const Dims l = large.dims(), s = small.dims();
-    const auto diff_small = at::upsample_trilinear3d_backward(to_plain(diff, large), {l[2], l[3], l[4]}, s, false, 2.0,
-                                                              2.0, 2.0);
-    return from_plain(diff_small, small);
+  // The gradient at an upsampling's input (layout `small`) from the one at its output (`large`,
+  // the same channel blocks).
+  Buffer upsampling_backward(const Buffer& diff, const Desc& small) {
+    Buffer out = buffer(small);
+    upsampling_adjoint(diff.storage.data_ptr<float>(), out.storage.data_ptr<float>(), small.dims(),
+                       channel_block(small));
+    return out;
   }
   Buffer from_plain(const torch::Tensor& t, const Desc& d) {
     const auto c = t.contiguous();
@@ -308,7 +344,8 @@ struct LightTrunkFunction : torch::autograd::Function<LightTrunkFunction> {
     const auto upsample_onto = [&](const Upsampling& up, const Buffer& small, const Buffer& skip, const Desc& d) {
       Buffer r = buffer(d);
       up.forward.execute(run.stream, {{DNNL_ARG_SRC, small.memory}, {DNNL_ARG_DST, r.memory}});
-      return run.sum(r, skip.storage, d);
+      r.storage.add_(skip.storage);  // r is new: the sum needs no buffer of its own
+      return r;
     };
     Buffer l2 = run.convolve(kLateral2, e2.memory, weight(kLateral2), bias(kLateral2));
     Buffer s1 = upsample_onto(g.up2, l2, e1, g.e1);
@@ -364,7 +401,7 @@ struct LightTrunkFunction : torch::autograd::Function<LightTrunkFunction> {
     };
     const auto add_level = [&](Buffer& b, size_t i, const Desc& d) {
       const auto extra = level_gradient(i, d);
-      if (extra.defined()) b = run.sum(b, extra, d);
+      if (extra.defined()) b.storage.add_(extra);  // b is this backward's own
     };
 
     // Back through layer l and its LeakyReLU (if it has one; `y` its output): its parameters'
@@ -389,19 +426,21 @@ struct LightTrunkFunction : torch::autograd::Function<LightTrunkFunction> {
     Buffer g_d0 = back_through(kQ, run.from_plain(dq, c[kQ].dst()), {}, at(kD0, d0_desc));
     add_level(g_d0, 4, d0_desc);
     const Buffer g_s0 = back_through(kUp0, g_d0, saved[kD0], at(kS0, g.e0));
-    const Buffer g_d1 = back_through(kLateral1, run.upsampling_backward(g_s0, g.e0, c[kLateral1].dst()), {},
+    const Buffer g_d1 = back_through(kLateral1, run.upsampling_backward(g_s0, c[kLateral1].dst()), {},
                                      at(kD1, c[kUp1].dst()));
     const Buffer g_s1 = back_through(kUp1, g_d1, saved[kD1], at(kS1, g.e1));
-    Buffer g_e2 = back_through(kLateral2, run.upsampling_backward(g_s1, g.e1, c[kLateral2].dst()), {},
+    Buffer g_e2 = back_through(kLateral2, run.upsampling_backward(g_s1, c[kLateral2].dst()), {},
                                at(kE2, g.e2));
     add_level(g_e2, 3, g.e2);
     const Buffer g_t2 = back_through(kDown22, g_e2, saved[kE2], at(kT2, c[kDown20].dst()));
     const Buffer g_p1 = back_through(kDown20, g_t2, saved[kT2], at(kP1, c[kDown20].src()));
-    Buffer g_e1 = run.sum(g_s1, unpool(g.pool1, g_p1, kWs1, g.e1).storage, g.e1);
+    Buffer g_e1 = unpool(g.pool1, g_p1, kWs1, g.e1);
+    g_e1.storage.add_(g_s1.storage);
     add_level(g_e1, 2, g.e1);
     const Buffer g_t1 = back_through(kDown12, g_e1, saved[kE1], at(kT1, c[kDown10].dst()));
     const Buffer g_p0 = back_through(kDown10, g_t1, saved[kT1], at(kP0, c[kDown10].src()));
-    Buffer g_e0 = run.sum(g_s0, unpool(g.pool0, g_p0, kWs0, g.e0).storage, g.e0);
+    Buffer g_e0 = unpool(g.pool0, g_p0, kWs0, g.e0);
+    g_e0.storage.add_(g_s0.storage);
     add_level(g_e0, 1, g.e0);
     Buffer g_a0 = run.through_leaky(g.leaky0_backward, g.e0, g_e0.memory, saved[kE0]);
     run.stream.wait();

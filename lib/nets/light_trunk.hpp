@@ -6,7 +6,7 @@
 // oneDNN's blocked layout from the first convolution to the last: bias and LeakyReLU fused into
 // each convolution, pooling and trilinear upsampling as oneDNN primitives, the backward as
 // oneDNN's backward primitives (the weight gradients as in nets/onednn.hpp; the upsampling's
-// backward LibTorch's, oneDNN having no vectorised kernel for it). The layers, their
+// backward our own, in the blocked layout, oneDNN having no vectorised kernel for it). The layers, their
 // order and their parameters are LightNet's (nets/qattention_modules.cpp); Q values and
 // gradients equal LibTorch's within fp32 rounding (tests/unit/nets/test_light_trunk.cpp).
 #pragma once
