@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cstring>
 #include <map>
 #include <memory>
@@ -29,6 +30,26 @@ constexpr auto f32 = memory::data_type::f32;
 constexpr float kLeaky = static_cast<float>(kLeakySlope);  // LightNet's LeakyReLU
 
 std::atomic<int> trunk_on{-1};  // -1: as onednn::layers_by_default()
+
+// light_trunk_time()'s counters, nanoseconds.
+enum Counter { kTrainingForward, kBackward, kInference, kForwardConvolutions, kBackwardData, kWeightGradients,
+               kLayouts, kCounters };
+std::array<std::atomic<int64_t>, kCounters> time_ns{};
+
+// Adds the wall time from its construction to its destruction to one counter.
+class Timed {
+ public:
+  explicit Timed(Counter c) : counter_(c), start_(std::chrono::steady_clock::now()) {}
+  ~Timed() {
+    time_ns[counter_] += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start_).count();
+  }
+  Timed(const Timed&) = delete;
+  Timed& operator=(const Timed&) = delete;
+
+ private:
+  Counter counter_;
+  std::chrono::steady_clock::time_point start_;
+};
 
 // LightNet's convolutions, in the order of their parameters.
 enum Layer { kInput, kDown10, kDown12, kDown20, kDown22, kLateral2, kUp1, kLateral1, kUp0, kQ, kLayers };
@@ -260,6 +281,7 @@ struct Run {
 
   // A layer's forward into a new buffer of its output layout.
   Buffer convolve(Layer layer, const memory& src, const torch::Tensor& weight, const torch::Tensor& bias) {
+    const Timed timed(kForwardConvolutions);
     const Convolution& c = g.convolution[layer];
     Buffer w = buffer(c.forward_pd.weights_desc()), dst = buffer(c.dst());
     memory torch_w = over(weight, Desc(weight.sizes().vec(), f32, Tag::oidhw));
@@ -272,6 +294,7 @@ struct Run {
   }
   // The gradient at a layer's input from the gradient at its output (before its activation).
   Buffer backward_data(Layer layer, const memory& diff_dst, const torch::Tensor& weight) {
+    const Timed timed(kBackwardData);
     const Convolution& c = g.convolution[layer];
     Buffer w = buffer(c.backward_pd.weights_desc()), diff_src = buffer(c.src());
     memory torch_w = over(weight, Desc(weight.sizes().vec(), f32, Tag::oidhw));
@@ -288,6 +311,7 @@ struct Run {
   }
   // A plain [N, C, ...] tensor from a buffer of layout d, and back.
   torch::Tensor to_plain(const Buffer& b, const Desc& d) {
+    const Timed timed(kLayouts);
     auto out = torch::empty(d.dims(), torch::kFloat);
     memory plain = over(out, Desc(d.dims(), f32, Tag::ncdhw)), src = b.memory;
     dnnl::reorder(src, plain).execute(stream, src, plain);
@@ -302,6 +326,7 @@ struct Run {
     return out;
   }
   Buffer from_plain(const torch::Tensor& t, const Desc& d) {
+    const Timed timed(kLayouts);
     const auto c = t.contiguous();
     Buffer out = buffer(d);
     memory plain = over(c, Desc(d.dims(), f32, Tag::ncdhw));
@@ -380,6 +405,7 @@ struct LightTrunkFunction : torch::autograd::Function<LightTrunkFunction> {
 
   static torch::autograd::variable_list backward(torch::autograd::AutogradContext* ctx,
                                                  torch::autograd::variable_list grads) {
+    const Timed timed(kBackward);
     const auto inputs = ctx->get_saved_variables();
     const auto saved = ctx->saved_data["activations"].toTensorVector();
     const torch::Tensor& grid = inputs[0];
@@ -392,7 +418,10 @@ struct LightTrunkFunction : torch::autograd::Function<LightTrunkFunction> {
     torch::autograd::variable_list out(2 + 2 * kLayers + 1);  // grid, proprio_bias, parameters, levels
     // The weight and bias gradients of a layer from its input x and the gradient at its output.
     const auto parameter_gradients = [&](Layer l, const memory& x, const Buffer& diff) {
-      out[2 + 2 * l] = onednn::weight_gradient(x, diff.memory, c[l].padding);
+      {
+        const Timed timed(kWeightGradients);
+        out[2 + 2 * l] = onednn::weight_gradient(x, diff.memory, c[l].padding);
+      }
       out[2 + 2 * l + 1] = bias_gradient(diff, c[l].dst());
     };
     const auto level_gradient = [&](size_t i, const Desc& d) -> torch::Tensor {
@@ -444,7 +473,10 @@ struct LightTrunkFunction : torch::autograd::Function<LightTrunkFunction> {
     add_level(g_e0, 1, g.e0);
     Buffer g_a0 = run.through_leaky(g.leaky0_backward, g.e0, g_e0.memory, saved[kE0]);
     run.stream.wait();
-    out[2 + 2 * kInput] = onednn::weight_gradient(over(grid, g.grid_plain), g_a0.memory, 1);
+    {
+      const Timed timed(kWeightGradients);
+      out[2 + 2 * kInput] = onednn::weight_gradient(over(grid, g.grid_plain), g_a0.memory, 1);
+    }
     const auto per_sample = voxel_sums(g_a0.storage, g.e0);
     out[2 + 2 * kInput + 1] = per_sample.sum(0);
     out[1] = per_sample;
@@ -461,6 +493,7 @@ std::vector<torch::Tensor> light_trunk(const torch::Tensor& grid, const torch::T
   // and each new size costs its primitives' creation (tens of milliseconds): batches larger than
   // 4 run padded with zero samples to a multiple of 4, so that few sizes ever occur.
   const int64_t n = grid.size(0), padded = n <= 4 ? n : (n + 3) / 4 * 4;
+  const Timed timed(torch::GradMode::is_enabled() ? kTrainingForward : kInference);
   if (torch::GradMode::is_enabled() || padded == n)
     return LightTrunkFunction::apply(grid, proprio_bias, at::TensorList(parameters), levels);
   const auto pad = [&](const torch::Tensor& t) {
@@ -478,6 +511,18 @@ bool light_trunk_supported(const torch::Tensor& grid, int base_channels) {
       grid.size(2) != grid.size(3) || grid.size(2) != grid.size(4))
     return false;
   return graph_for(grid.size(0), grid.size(1), base_channels, grid.size(2)).supported;
+}
+
+TrunkTime light_trunk_time() {
+  std::array<double, kCounters> s{};
+  for (int c = 0; c < kCounters; ++c) s[c] = static_cast<double>(time_ns[c].load()) * 1e-9;
+  TrunkTime t;
+  t.training_forward_s = s[kTrainingForward], t.backward_s = s[kBackward], t.inference_s = s[kInference];
+  t.forward_convolutions_s = s[kForwardConvolutions], t.backward_data_s = s[kBackwardData];
+  t.weight_gradients_s = s[kWeightGradients], t.layouts_s = s[kLayouts];
+  t.other_s = t.training_forward_s + t.backward_s + t.inference_s - t.forward_convolutions_s - t.backward_data_s -
+              t.weight_gradients_s - t.layouts_s;
+  return t;
 }
 
 void use_onednn_trunk(bool on) { trunk_on = on; }

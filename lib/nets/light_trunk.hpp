@@ -36,4 +36,19 @@ bool light_trunk_supported(const torch::Tensor& grid, int base_channels);
 void use_onednn_trunk(bool on);
 bool onednn_trunk_in_use();
 
+// Wall time light_trunk has spent since the program started, by pass and by kind of work, for
+// the benchmarks' share of the machine and where-the-time-goes tables (a clock read around each
+// step: the CPU engine runs its primitives synchronously). The kinds add up to the passes.
+struct TrunkTime {
+  double training_forward_s = 0;  // forwards with gradients (a learner's training step)
+  double backward_s = 0;
+  double inference_s = 0;           // forwards without gradients (acting, targets)
+  double forward_convolutions_s = 0;  // with their fused bias and LeakyReLU
+  double backward_data_s = 0;         // the convolutions' input gradients
+  double weight_gradients_s = 0;      // the swapped convolutions and their reorders
+  double layouts_s = 0;               // plain <-> blocked conversions at the trunk's ends
+  double other_s = 0;  // LeakyReLU backwards, pooling, upsampling, sums, bias gradients, buffers
+};
+TrunkTime light_trunk_time();
+
 }  // namespace qte::nets

@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "light_layers.hpp"
 #include "machine_peak.hpp"
 #include "nets/conv3d.hpp"
 #include "nets/qattention_net.hpp"
@@ -30,28 +31,8 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-struct Layer {
-  std::string name;
-  int in, out, kernel, voxels;  // kernel 0: a linear layer (voxels 1)
-  int64_t macs_per_sample() const {
-    const int64_t v = static_cast<int64_t>(voxels) * voxels * voxels;
-    return kernel == 0 ? static_cast<int64_t>(in) * out
-                       : v * in * out * static_cast<int64_t>(kernel) * kernel * kernel;
-  }
-};
-
-// light at 16 base channels (lib/nets/qattention_modules.cpp, LightNet): e0 at 16^3, e1 at
-// 8^3, e2 at 4^3, then back up; the dense head pools 4 levels of 16 + 32 + 64 + 16 channels.
-std::vector<Layer> light_layers() {
-  const int k = 16, c = 10;
-  return {{"input conv3", c, k, 3, 16},          {"down1.0 conv3", k, 2 * k, 3, 8},
-          {"down1.2 conv3", 2 * k, 2 * k, 3, 8}, {"down2.0 conv3", 2 * k, 4 * k, 3, 4},
-          {"down2.2 conv3", 4 * k, 4 * k, 3, 4}, {"lateral2 conv1", 4 * k, 2 * k, 1, 4},
-          {"up1 conv3", 2 * k, 2 * k, 3, 8},     {"lateral1 conv1", 2 * k, k, 1, 8},
-          {"up0 conv3", k, k, 3, 16},            {"q conv1", k, 1, 1, 16},
-          {"head.0 linear", 4 * 128, 128, 0, 1}, {"head.2 linear", 128, 128, 0, 1},
-          {"head.4 linear", 128, qte::nets::kRotationAxes * qte::nets::kRotationBins + qte::nets::kGripperActions, 0, 1}};
-}
+using qte::bench::Layer;
+using qte::bench::light_layers;
 
 torch::nn::AnyModule make(const Layer& l) {
   if (l.kernel == 0) return torch::nn::AnyModule(torch::nn::Linear(l.in, l.out));

@@ -31,6 +31,7 @@
 #include "learner/targets.hpp"
 #include "machine_peak.hpp"
 #include "nets/conv3d.hpp"
+#include "light_layers.hpp"
 #include "nets/light_trunk.hpp"
 #include "nets/qattention_modules.hpp"
 #include "replay/replay_buffer.hpp"
@@ -132,7 +133,7 @@ int main(int argc, char** argv) {
   }
 
   learner::QLearner learner(config);
-  std::vector<double> sample_s, assemble_s, target_s, full_s;
+  std::vector<double> sample_s, assemble_s, target_s, full_s, trunk_training_s;
   for (int step = 0; step <= steps; ++step) {  // step 0 warms up
     std::mt19937_64 rng(step);
     const auto t0 = Clock::now();
@@ -144,8 +145,10 @@ int main(int argc, char** argv) {
     const auto t2 = Clock::now();
     learner.targets(mb);  // timed alone; train_step computes them again
     const double t_targets = since(t2);
+    const nets::TrunkTime trunk_before = nets::light_trunk_time();
     const auto t3 = Clock::now();
     const learner::StepStats stats = learner.train_step(mb);
+    const nets::TrunkTime trunk_after = nets::light_trunk_time();
     replay.update_priorities(sample.indices, stats.td_errors);
     const double t_train = since(t3);
     if (step == 0) continue;
@@ -153,6 +156,8 @@ int main(int argc, char** argv) {
     assemble_s.push_back(t_assemble);
     target_s.push_back(t_targets);
     full_s.push_back(t_sample + t_assemble + t_train);
+    trunk_training_s.push_back(trunk_after.training_forward_s + trunk_after.backward_s -
+                               trunk_before.training_forward_s - trunk_before.backward_s);
   }
   const double full = median(full_s), targets = median(target_s), assemble = median(assemble_s);
   std::printf("%s batch %d, %d depths, tree target K=%d, %d threads, median of %d steps, %s:\n", arch.c_str(), batch,
@@ -163,15 +168,21 @@ int main(int argc, char** argv) {
               full, median(sample_s), assemble, targets, full - median(sample_s) - assemble - targets);
   std::printf("  per depth        %.3f s  (full step / depths: compare with the reference's bare step per depth)\n",
               full / config.hierarchy.depths);
-  // The trunk's share of the machine: FLOPs from the layers' multiply-accumulates (x2), x3 for
-  // forward + backward (input and weight gradients), over the forward+backward+Adam time.
-  double macs = 0;
+  // The trunk's share of the machine: FLOPs from the layers' multiply-accumulates (x2) of the
+  // forward, the input gradients (none for the grid) and the weight gradients, over the time the
+  // oneDNN trunk's forwards with gradients and backwards take in the step (nets/light_trunk.hpp);
+  // with LibTorch's layers, which have no such clock, over the forward+backward+Adam time above.
+  const bool own_clock = median(trunk_training_s) > 0;
+  const double trunk_s = own_clock ? median(trunk_training_s) : full - median(sample_s) - assemble - targets;
+  double macs = 0;  // arm: every layer's, the backward counted as twice the forward
   for (const nets::QAttentionNet& net : learner.online()) macs += static_cast<double>(net.module().multiply_accumulates());
-  const double trunk_s = full - median(sample_s) - assemble - targets, trunk_gflop = macs * 2 * 3 * batch / 1e9;
+  const double trunk_gflop = (arch == "light" ? bench::light_trunk_flops().training() * config.hierarchy.depths
+                                              : macs * 2 * 3) * batch / 1e9;
   const bench::Peak peak = bench::measure_fp32_peak(threads);
-  std::printf("trunk: %.1f GFLOP/s, %.0f%% of peak (forward + backward of all depths: %.1f GFLOP in %.3f s; "
+  std::printf("trunk: %.1f GFLOP/s, %.0f%% of peak (forward + backward of all depths: %.1f GFLOP in %.3f s, %s; "
               "peak %.0f GFLOP/s fp32 on %d threads, %s)\n",
-              trunk_gflop / trunk_s, 100 * trunk_gflop / trunk_s / peak.gflops, trunk_gflop, trunk_s, peak.gflops, threads,
+              trunk_gflop / trunk_s, 100 * trunk_gflop / trunk_s / peak.gflops, trunk_gflop, trunk_s,
+              own_clock ? "the trunk's own time in the step" : "the step's forward+backward+Adam", peak.gflops, threads,
               peak.isa.c_str());
   return 0;
 }
