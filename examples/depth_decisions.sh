@@ -4,7 +4,7 @@
 # or elsewhere, and how often a finer depth overruled depth 0's argmax (tree expansion, K > 1).
 # Usage: depth_decisions.sh TASK CHECKPOINT K [IMAGE] [EPISODES] [LABEL] [QTE-SELECT OPTIONS...]
 #        (the built programs on PATH). The scenes are learn.sh's evaluation scenes: VARIATION
-#        (0) and EVAL_SEED (1000000) as there, as failure_reasons.sh replays them. DECISION_STEP=N:
+#        (0), EVAL_SEED (1000000) and PLAN_OPTIONS as there, as failure_reasons.sh replays them. DECISION_STEP=N:
 #        only the decisions at step N of each episode (0: the first). AGENT=FILE keeps the
 #        episodes' records there.
 set -euo pipefail
@@ -18,5 +18,5 @@ agent_loop "$tmp/loop" \
   sim-step --task "$task" --variation "${VARIATION:-0}" --episodes "$episodes" --seed "${EVAL_SEED:-1000000}" \
     --scenes eval --image-size "$image" --objects \
   qte-select --checkpoint "$checkpoint" --k "$k" "$@" --threads 1 \
-  plan-path > "$agent"
+  plan-path ${PLAN_OPTIONS:-} > "$agent"
 "$PYTHON" "$here/depth_decisions.py" --label "$label" ${DECISION_STEP:+--step "$DECISION_STEP"} "$agent"

@@ -5,7 +5,7 @@
 # the planner's or the simulator's refusal, out of steps), counted per reason.
 # Usage: failure_reasons.sh TASK CHECKPOINT K [IMAGE] [EPISODES] [LABEL] [SEED] [QTE-SELECT OPTIONS...]
 #        (the built programs on PATH). The scenes are learn.sh's evaluation scenes: VARIATION
-#        (0) and EVAL_SEED (1000000) as there. FAILURE_EPISODES=1: a line per episode on stderr.
+#        (0), EVAL_SEED (1000000) and PLAN_OPTIONS as there. FAILURE_EPISODES=1: a line per episode on stderr.
 # The expert's episodes of the scenes are recorded once per task, VARIATION, EVAL_SEED,
 # EPISODES, IMAGE and demo-record program (its checksum: a rebuilt expert records again) and
 # kept in EXPERT_CACHE, by default expert-cache/ beside the run directory (the checkpoint's
@@ -33,6 +33,6 @@ fi
 agent_loop "$tmp/loop" \
   sim-step "${scenes[@]}" --objects \
   qte-select --checkpoint "$checkpoint" --k "$k" "$@" --threads 1 \
-  plan-path > "$tmp/agent.rec"
+  plan-path ${PLAN_OPTIONS:-} > "$tmp/agent.rec"
 "$PYTHON" "$here/failure_reasons.py" --label "$label" --seed "$seed" ${FAILURE_EPISODES:+--episodes} \
   "$experts" "$tmp/agent.rec"

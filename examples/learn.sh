@@ -44,6 +44,8 @@
 #
 # NET_OPTIONS: the coarse-to-fine hierarchy when not the published one, for keyframe and the
 # learner alike (e.g. "--depths 3 --offset 0.15,0.05"; qte-select takes it from the checkpoint).
+# PLAN_OPTIONS: plan-path's options for the agent's moves, in training and in every evaluation
+# (e.g. "--approach 0.1": grasps end in a straight descent along the tool axis; plan-path(1)).
 #
 # A real robot (docs/real-world.md): STAGE is the world the agent acts in, a program with its
 # options (quoted words stay together): the simulator at IMAGE by default, or robot-step with
@@ -61,7 +63,8 @@ source "$(dirname "$0")/common.sh"
 : "${N_STEP:=1}" "${ACTORS:=1}" "${CPU_BUDGET:=0}" "${K_MARGIN:=0.02}" "${K_MAX:=10}" "${ROLE:=all}" "${ACTOR_INDEX:=0}"
 : "${ALSO_ACT_K:=}" "${METHOD:=qte}" "${LABEL:=$(run_label "$METHOD" "$ACT_K" "$TARGET_K" "$K_MARGIN" "$K_MAX")}"
 : "${STAGE:=sim-step --image-size $IMAGE}" "${DEMOS_FROM:=}" "${TIME_BUDGET:=0}" "${NET_OPTIONS:=}"
-: "${EVAL_STAGE:=$STAGE}"
+: "${PLAN_OPTIONS:=}" "${EVAL_STAGE:=$STAGE}"
+export PLAN_OPTIONS  # failure_reasons.sh plans the final agent's moves the same way
 eval "stage=($STAGE)"
 eval "eval_stage=($EVAL_STAGE)"
 mkdir -p "$run/actors" "$run/eval"
@@ -199,7 +202,7 @@ start_actor() {  # ACTOR: its pipeline, in the background, from its first chunk 
         --chunk-episodes "$CHUNK_EPISODES" --first-chunk "$(next_chunk "$i")" --chunk-stride "$ACTORS" --gate "$gate" --compress \
       qte-select --checkpoint "$run/ckpt/latest.rec" --reload --k "$ACT_K" $act_branching --epsilon "$EPSILON" \
         --rotation-noise "$ROTATION_NOISE" --seed $(( SEED * 100000 + i )) --threads 1 \
-      plan-path \
+      plan-path $PLAN_OPTIONS \
       '|' keyframe --agent --seed "$SEED" $NET_OPTIONS --append --output "$actor_replay"
     echo "${agent_loop_status[*]}" > "$run/actors/status-$i"
   ) 2>> "$run/actor.log" &
@@ -328,7 +331,7 @@ evaluate() {  # CHECKPOINT ENV_STEPS OUT.csv LEARNER_STEP EVAL_POINT
   agent_loop "$fifo" \
     "${eval_stage[@]}" --task "$task" --variation "$VARIATION" --episodes "$EVAL_EPISODES" --seed "$EVAL_SEED" --scenes eval \
     qte-select --checkpoint "$1" --k "$ACT_K" $act_branching --threads 1 \
-    plan-path \
+    plan-path $PLAN_OPTIONS \
     '|' episode-stats --label "$LABEL" --column seed="$SEED" --column env_steps="$2" --column train_step="$4" \
       --column eval_point="$5" --column train_s="$(cat "$run/train_seconds")" $(cpu_columns) \
     > "$3.tmp"

@@ -26,6 +26,8 @@ TITLES = {
     "takeaway3": "Takeaway 3: ablations on `reach_prism`",
     "takeaway4": "Takeaway 4: the real-world task in simulation (`reach_prism`, 10 minutes of training)",
     "takeaway4-unpaced": "Takeaway 4 without pacing (the earlier protocol, superseded)",
+    "takeaway1-pick_up_cup-planned-to-grasp":
+        "Takeaway 1's `pick_up_cup` with grasps planned to the grasp itself (superseded: the path swept through the cup)",
 }
 ROLES = ["demos", "pretrain", "learner", "actor", "other"]
 

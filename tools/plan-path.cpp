@@ -25,12 +25,17 @@ static cli::Usage usage() {
       "<camera>.points, inserted as rays from the camera so free space is known; unknown space "
       "counts as free), with the robot's own links and a held object filtered out, and an exact "
       "Euclidean distance field over its occupied voxels; those follow from the rays' endpoints, "
-      "so the rays are traced only for --octomap. The robot is a set of spheres checked against that "
-      "field and against itself. Inverse kinematics is damped least squares with joint limits "
+      "so the rays are traced only for --octomap. Points within 6 cm of the goal are left out: the "
+      "agent chose to go there (a reach target, a success zone, the object it grasps). The robot is "
+      "a set of spheres checked against that field and against itself. Inverse kinematics is damped least squares with joint limits "
       "and seeded restarts, taking the collision-free solution nearest the current joints "
       "(accuracy 0.5 mm, 0.23 degrees). The direct joint-space line is tried first, then "
       "OMPL's RRT-Connect within --time-budget, then deterministic shortcutting. Moves with "
-      "ignore_collisions set follow a straight line of the gripper instead (grasp approaches).",
+      "ignore_collisions set follow a straight line of the gripper instead (grasp approaches). With "
+      "--approach, a grasp (a move that ends closing the open gripper) is planned to the pose that "
+      "distance back along the tool axis with nothing left out of the map, so the path cannot sweep "
+      "through the object it goes for, and ends in a straight line to the grasp; its method is then "
+      "direct+approach or rrt_connect+approach.",
       "Same inputs and --seed give the same bytes, unless a plan hits the time budget.",
   };
   u.arguments = {cli::input_file()};

@@ -40,6 +40,9 @@ constexpr double kBranchJump_rad = 0.3;
 // 0.2 of the space's extent, is about 3 rad here; shorter edges extend the trees in steps a
 // collision check along the edge rarely rejects. Chosen, not tuned by a measurement here.
 constexpr double kRrtRange_rad = 0.5;
+// An empty gripper opened wider than this can close on something: a move ending in a close is
+// a grasp (the xArm gripper opens 8.5 cm).
+constexpr double kOpenGripper_m = 0.02;
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
@@ -103,7 +106,10 @@ OccupancyScene MotionPlanner::scene_from(const stream::Record& obs, const StartS
   spheres_.place(start.joints, start.opening_m, world_from_base_, robot_now);
   std::vector<Sphere> free_regions;
   if (start.holding) free_regions.push_back({world_from_base_ * robot_.tcp_pose(start.joints).translation(), 0.06, -1});
-  if (goal && goal->pose_valid) free_regions.push_back({goal->tcp_pose.translation(), options_.goal_free_radius_m, -1});
+  // A grasp with a straight final approach sees the object it goes for: its path may not pass
+  // through it, and the approach itself is checked against the robot and the table only.
+  if (goal && goal->pose_valid && !approaches(start, *goal))
+    free_regions.push_back({goal->tcp_pose.translation(), options_.goal_free_radius_m, -1});
   OccupancyScene scene(options_.scene);
   for (const auto& camera : cameras) {
     const auto points = obs.array<float>(camera + ".points");
@@ -171,6 +177,11 @@ PlanResult MotionPlanner::finish(std::vector<robot::JointVector> path, const std
   return result;
 }
 
+bool MotionPlanner::approaches(const StartState& start, const Goal& goal) const {
+  const bool grasp = !goal.gripper_open && !start.holding && start.opening_m > kOpenGripper_m;
+  return options_.approach_m > 0 && grasp && !goal.ignore_collisions;
+}
+
 PlanResult MotionPlanner::plan(const StartState& start, const Goal& goal, const OccupancyScene& scene,
                                uint64_t plan_index) const {
   const auto t0 = Clock::now();
@@ -184,12 +195,31 @@ PlanResult MotionPlanner::plan(const StartState& start, const Goal& goal, const 
   if (goal.ignore_collisions) return plan_ignoring_scene(start, goal_in_base, ik, t0);
 
   if (!checker_.state_valid(start.joints, start.opening_m, &scene)) return failed("start_in_collision", t0);
-  std::string failure;
-  const auto goal_q = goal_configuration(start, goal_in_base, scene, ik, failure);
-  if (!goal_q) return failed(failure, t0);
-  if (checker_.motion_valid(start.joints, *goal_q, start.opening_m, &scene))
-    return finish({start.joints, *goal_q}, "direct", t0);
-  return rrt_connect(start, *goal_q, scene, plan_index, t0);
+  const bool approach = approaches(start, goal);
+  // With an approach, the planned move ends approach_m back along the TCP's z axis.
+  const Eigen::Isometry3d end_in_base =
+      approach ? goal_in_base * Eigen::Translation3d(0, 0, -options_.approach_m) : goal_in_base;
+  std::string failure, method;
+  const auto end_q = goal_configuration(start, end_in_base, scene, ik, failure);
+  if (!end_q) return failed(failure, t0);
+  std::vector<robot::JointVector> approach_path;
+  if (approach && !straight_line(*end_q, goal_in_base, start.opening_m, approach_path)) return failed("no_path", t0);
+  std::vector<robot::JointVector> path = path_to(start, *end_q, scene, plan_index, method, failure);
+  if (path.empty()) return failed(failure, t0);
+  if (!approach) return finish(std::move(path), method, t0);
+  path.insert(path.end(), approach_path.begin() + 1, approach_path.end());
+  return finish(std::move(path), method + "+approach", t0);
+}
+
+std::vector<robot::JointVector> MotionPlanner::path_to(const StartState& start, const robot::JointVector& goal_q,
+                                                       const OccupancyScene& scene, uint64_t plan_index,
+                                                       std::string& method, std::string& failure) const {
+  if (checker_.motion_valid(start.joints, goal_q, start.opening_m, &scene)) {
+    method = "direct";
+    return {start.joints, goal_q};
+  }
+  method = "rrt_connect";
+  return rrt_connect(start, goal_q, scene, plan_index, failure);
 }
 
 // Grasp approaches and retreats: a straight line of the TCP, else straight in joint space,
@@ -223,8 +253,9 @@ std::optional<robot::JointVector> MotionPlanner::goal_configuration(const StartS
 
 // RRT-Connect in joint space. Joints with 720-degree ranges are kept within half a turn of
 // the start: more is never needed and it keeps collision checks dense.
-PlanResult MotionPlanner::rrt_connect(const StartState& start, const robot::JointVector& goal_q,
-                                      const OccupancyScene& scene, uint64_t plan_index, Clock::time_point t0) const {
+std::vector<robot::JointVector> MotionPlanner::rrt_connect(const StartState& start, const robot::JointVector& goal_q,
+                                                           const OccupancyScene& scene, uint64_t plan_index,
+                                                           std::string& failure) const {
   auto space = std::make_shared<ob::RealVectorStateSpace>(robot::kArmJoints);
   ob::RealVectorBounds bounds(robot::kArmJoints);
   const robot::JointVector lo = robot_.lower_limits(), hi = robot_.upper_limits();
@@ -255,13 +286,14 @@ PlanResult MotionPlanner::rrt_connect(const StartState& start, const robot::Join
   const ob::PlannerStatus status = setup.solve(ob::plannerOrTerminationCondition(
       ob::timedPlannerTerminationCondition(options_.time_budget_s),
       ob::exactSolnPlannerTerminationCondition(setup.getProblemDefinition())));
-  if (status != ob::PlannerStatus::EXACT_SOLUTION)
-    return failed(status == ob::PlannerStatus::TIMEOUT || status == ob::PlannerStatus::APPROXIMATE_SOLUTION ? "timeout"
-                                                                                                          : "no_path",
-                  t0);
+  if (status != ob::PlannerStatus::EXACT_SOLUTION) {
+    const bool timeout = status == ob::PlannerStatus::TIMEOUT || status == ob::PlannerStatus::APPROXIMATE_SOLUTION;
+    failure = timeout ? "timeout" : "no_path";
+    return {};
+  }
   std::vector<robot::JointVector> path;
   for (const ob::State* s : setup.getSolutionPath().getStates()) path.push_back(to_joints(s));
-  return finish(shortcut(path, opening, &scene), "rrt_connect", t0);
+  return shortcut(path, opening, &scene);
 }
 
 stream::Record action_record(const Goal& goal) {

@@ -30,6 +30,12 @@ struct PlannerOptions {
   double sample_period_s = 0.05;       // trajectory samples (sim-step's control period)
   double straight_step_m = 0.01;       // TCP step of straight-line moves
   double goal_free_radius_m = 0.06;    // around the goal TCP, points are not obstacles
+  // Grasps (a move that ends closing an open, empty gripper) with approach_m > 0: planned to
+  // the pose approach_m back along the TCP's z axis on the whole sensed scene (the object to be
+  // grasped an obstacle like any other), then a straight line to the goal checked against the
+  // robot and the table, as a grasp approach. 0: planned to the goal itself, around which
+  // goal_free_radius_m is free space.
+  double approach_m = 0;
   CollisionCheckOptions collision;     // clearance, check step, the table (under its top is never free)
   uint64_t seed = 0;
   SceneOptions scene;
@@ -76,6 +82,8 @@ class MotionPlanner {
                   uint64_t plan_index = 0) const;
 
   const CollisionChecker& collisions() const { return checker_; }
+  // Whether this move is a grasp planned with a straight final approach (options.approach_m).
+  bool approaches(const StartState& start, const Goal& goal) const;
 
  private:
   // The steps of plan(): a move that ignores the sensed scene; the goal configuration (the
@@ -85,8 +93,14 @@ class MotionPlanner {
   std::optional<robot::JointVector> goal_configuration(const StartState& start, const Eigen::Isometry3d& goal_in_base,
                                                        const OccupancyScene& scene, robot::IkOptions ik,
                                                        std::string& failure) const;
-  PlanResult rrt_connect(const StartState& start, const robot::JointVector& goal_q, const OccupancyScene& scene,
-                         uint64_t plan_index, Clock::time_point t0) const;
+  // A collision-free joint path from the start to goal_q: the direct line, else RRT-Connect
+  // (shortcut); empty with `failure` set when there is none.
+  std::vector<robot::JointVector> path_to(const StartState& start, const robot::JointVector& goal_q,
+                                          const OccupancyScene& scene, uint64_t plan_index, std::string& method,
+                                          std::string& failure) const;
+  std::vector<robot::JointVector> rrt_connect(const StartState& start, const robot::JointVector& goal_q,
+                                              const OccupancyScene& scene, uint64_t plan_index,
+                                              std::string& failure) const;
   PlanResult finish(std::vector<robot::JointVector> path, const std::string& method, Clock::time_point t0) const;
   std::vector<robot::JointVector> shortcut(std::vector<robot::JointVector> path, double opening_m,
                                            const OccupancyScene* scene) const;

@@ -17,6 +17,10 @@ std::vector<cli::OptionSpec> planner_options() {
       {"acceleration", "A", "joint acceleration limit, rad/s^2", default_text(d.max_acceleration_rad_s2)},
       {"clearance", "M", "extra distance in metres kept from occupied voxels", default_text(d.collision.clearance_m)},
       {"resolution", "M", "OctoMap voxel size in metres", default_text(d.scene.resolution_m)},
+      {"approach", "M",
+       "grasps (moves that end closing an open gripper): plan to M metres back along the tool axis on the whole "
+       "scene, then a straight line to the grasp; 0 plans to the grasp itself with the space around it free",
+       default_text(d.approach_m)},
   };
 }
 
@@ -28,6 +32,7 @@ PlannerOptions planner_options_from(const cli::Arguments& args) {
     options.max_acceleration_rad_s2 = args.real("acceleration", 0.1, 1000);
     options.collision.clearance_m = args.real("clearance", 0, 0.5);
     options.scene.resolution_m = args.real("resolution", 0.002, 0.1);
+    options.approach_m = args.real("approach", 0, 0.3);
   }
   options.seed = args.seed();
   return options;

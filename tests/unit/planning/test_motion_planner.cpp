@@ -224,3 +224,54 @@ TEST(MotionPlanner, IgnoreCollisionsMovesInAStraightLine) {
     EXPECT_LT((a + t * (b - a) - p).norm(), 0.002);
   }
 }
+
+// A grasp commanded straight from the start pose, as a learning agent does before it has
+// learned the pose above the object: with the space around the goal left out of the map, the
+// path may sweep through the cup it goes for; with --approach it is planned to the pose 10 cm
+// back along the tool axis on the whole map and ends in a straight descent, as the expert's.
+TEST(MotionPlanner, GraspsApproachAlongTheToolAxis) {
+  int swept = 0, approached = 0;
+  for (int64_t seed = 0; seed < 6; ++seed) {
+    Scene scene("pick_up_cup", seed);
+    const int cup = scene.world().object_id("cup");
+    const world::ObjectSpec& spec = scene.world().object_spec(cup);
+    const Eigen::Vector3d centre = scene.world().object_pose(cup) * spec.grasp_region.center();
+    Goal grasp = pose_goal(centre);
+    grasp.gripper_open = false;
+    const StartState start = start_state_from(scene.obs);
+    for (const double approach : {0.0, 0.1}) {
+      PlannerOptions options;
+      options.approach_m = approach;
+      MotionPlanner planner(xarm(), scene.world().robot_base_pose(), options);
+      ASSERT_EQ(planner.approaches(start, grasp), approach > 0);
+      const OccupancyScene occupancy = planner.scene_from(scene.obs, start, &grasp);
+      const PlanResult plan = planner.plan(start, grasp, occupancy, static_cast<uint64_t>(seed));
+      ASSERT_EQ(plan.failure, "") << "seed " << seed << " approach " << approach;
+      scene.world().set_robot_state(start.joints, start.opening_m);
+      const std::string contact = first_contact(scene.world(), plan);
+      if (approach == 0) {
+        swept += !contact.empty();
+        continue;
+      }
+      ++approached;
+      EXPECT_NE(plan.method.find("+approach"), std::string::npos) << plan.method;
+      EXPECT_EQ(contact, "") << "seed " << seed << " via " << plan.method;
+      // Every sample within 10 cm of the goal lies on the tool axis above it.
+      const Eigen::Vector3d axis = grasp.tcp_pose.linear().col(2);
+      bool reached_start_of_approach = false;
+      for (const auto& q : plan.joint_positions) {
+        const Eigen::Vector3d p = (scene.world().robot_base_pose() * xarm().tcp_pose(q)).translation();
+        const Eigen::Vector3d d = p - centre;
+        if (d.norm() > 0.1 - 1e-3) continue;
+        reached_start_of_approach = true;
+        EXPECT_LT((d - d.dot(axis) * axis).norm(), 0.002) << "seed " << seed;
+        EXPECT_LE(d.dot(axis), 1e-3);  // behind the goal, never past it
+      }
+      EXPECT_TRUE(reached_start_of_approach);
+      const Eigen::Isometry3d reached = scene.world().robot_base_pose() * xarm().tcp_pose(plan.joint_positions.back());
+      EXPECT_LE((reached.translation() - centre).norm(), 0.001);
+    }
+  }
+  EXPECT_EQ(approached, 6);
+  EXPECT_GE(swept, 3) << "too few paths to a grasp planned with the goal's surroundings free touched the cup";
+}
