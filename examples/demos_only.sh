@@ -7,7 +7,8 @@
 # objects apart, and no tree expansion can use it.
 # Usage: demos_only.sh TASK OUT_DIR   (the built programs on PATH; settings from the
 #        environment: SEED 0, DEMOS 10, IMAGE 256x256, STEPS 2000, N_STEP 3, VARIATION 0,
-#        NET_OPTIONS e.g. "--depths 3 --offset 0.15,0.05"; make -C examples demos-only).
+#        NET_OPTIONS e.g. "--depths 3 --offset 0.15,0.05", PLAN_OPTIONS as learn.sh's; make -C
+#        examples demos-only, which sets PLAN_OPTIONS as the task's runs have it).
 # Writes OUT_DIR/failures-stepSTEPS-kK.csv; resumable (the learner resumes, finished CSVs stay).
 set -euo pipefail
 task=$1 out=$2

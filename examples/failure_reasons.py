@@ -36,8 +36,8 @@ and has one reason (REASONS), the first cause in the episode that explains the f
                        expert holds an object on the scene; always when sorting one stream)
     dropped            the gripper opened on a target it held (let go of it, or put it where
                        the task does not count it)
-    goal_in_collision, ik_failed, no_path, start_in_collision, outside_workspace, invalid_pose
-                       the planner found no trajectory (plan-path's failure; its timeout, no
+    goal_in_collision, ik_failed, no_path, start_in_collision, outside_workspace, invalid_pose,
+    approach_blocked   the planner found no trajectory (plan-path's failure; its timeout, no
                        path within the time budget, counts as no_path)
     trajectory_refused sim-step refused the trajectory (invalid_trajectory, joint_limits,
                        velocity_limit)
@@ -168,10 +168,10 @@ def classify(expert, agent):
 
 
 REASONS = ["success", "wrong_object", "grasp_missed", "dropped", "goal_in_collision", "ik_failed", "no_path",
-           "start_in_collision", "outside_workspace", "invalid_pose", "trajectory_refused", "collision",
+           "start_in_collision", "outside_workspace", "invalid_pose", "approach_blocked", "trajectory_refused", "collision",
            "other_failure", "out_of_steps"]
 PLANNER_FAILURES = {"goal_in_collision", "ik_failed", "no_path", "start_in_collision", "outside_workspace",
-                    "invalid_pose"}
+                    "invalid_pose", "approach_blocked"}
 REFUSED_TRAJECTORIES = {"invalid_trajectory", "joint_limits", "velocity_limit"}
 
 

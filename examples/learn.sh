@@ -68,6 +68,14 @@ export PLAN_OPTIONS  # failure_reasons.sh plans the final agent's moves the same
 eval "stage=($STAGE)"
 eval "eval_stage=($EVAL_STAGE)"
 mkdir -p "$run/actors" "$run/eval"
+# The planner's options are the run's own: kept in it, so that a resumed run and every later
+# replay of its agent (failures_of_runs.sh) plan as it did.
+if [ -f "$run/plan_options" ]; then
+  [ "$(cat "$run/plan_options")" = "$PLAN_OPTIONS" ] || {
+    echo "learn.sh: $run was started with PLAN_OPTIONS='$(cat "$run/plan_options")', not '$PLAN_OPTIONS'" >&2; exit 2; }
+else
+  echo "$PLAN_OPTIONS" > "$run/plan_options"
+fi
 # The script's own waiting costs no process (it is counted in the budget, and a method that
 # takes longer would pay more for it): a read with a timeout on a FIFO nobody writes.
 [ -p "$run/actors/.tick" ] || mkfifo "$run/actors/.tick"

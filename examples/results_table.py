@@ -77,10 +77,12 @@ def failures(paths):
         writer.writerows(rows)
 
 
-# failure_reasons.py's reasons, the columns after failed_actions (success has its own column).
+# failure_reasons.py's reasons, the columns after failed_actions (success has its own column);
+# those added later count 0 in the CSVs written before them.
 REASONS = ["wrong_object", "grasp_missed", "dropped", "goal_in_collision", "ik_failed", "no_path",
-           "start_in_collision", "outside_workspace", "invalid_pose", "trajectory_refused", "collision",
-           "other_failure", "out_of_steps"]
+           "start_in_collision", "outside_workspace", "invalid_pose", "approach_blocked", "trajectory_refused",
+           "collision", "other_failure", "out_of_steps"]
+LATER_REASONS = {"approach_blocked"}
 
 
 def reasons(paths):
@@ -91,14 +93,14 @@ def reasons(paths):
         suffix = re.search(r"_act-k(\d+)\.csv$", path)
         with open(path, newline="") as f:
             for row in csv.DictReader(f):
-                if not all(row.get(r) for r in REASONS):
+                if not all(row.get(r) for r in REASONS if r not in LATER_REASONS):
                     continue
                 own = label_settings(row["label"])
                 act_k = suffix.group(1) if suffix else str(own[1]) if own else ""
                 total = sums[(task_of(re.sub(r"_act-k\d+\.csv$", ".csv", path), row), row["label"], act_k)]
                 total["runs"] += 1
                 for column in ["episodes", "success"] + REASONS:
-                    total[column] += int(row[column])
+                    total[column] += int(row.get(column) or 0)
     return [{"task": task, "label": label, "acting_k": k, **{c: t[c] for c in ["runs", "episodes", "success"] + REASONS}}
             for (task, label, k), t in sorted(sums.items(), key=lambda kv: (kv[0][0], kv[0][1], int(kv[0][2] or 0)))]
 
@@ -160,7 +162,10 @@ def curves(paths, task):
     rows.sort(key=lambda r: (r["label"], int(r["seed"]), float(r["eval_point"])))
     if not rows:
         sys.exit(f"no runs of task '{task}' among the {len(paths)} given")
-    writer = csv.DictWriter(sys.stdout, fieldnames=list(rows[0].keys()), lineterminator="\n")
+    # The columns every run has (runs of one takeaway may differ in the rest: CPU by role), so
+    # that the tasks' curves, printed one after another, share one header.
+    fields = ["task", "label", "seed", "env_steps", "eval_point", "episodes", "successes", "success_rate"]
+    writer = csv.DictWriter(sys.stdout, fieldnames=fields, lineterminator="\n", extrasaction="ignore")
     writer.writeheader()
     writer.writerows(rows)
 

@@ -20,7 +20,7 @@ static cli::Usage usage() {
       "frame; gripper_open; ignore_collisions) plan-path writes a 'trajectory' record: time-stamped "
       "joint waypoints within the joint velocity and acceleration limits and the gripper command, "
       "or only a 'failure' with the reason: invalid_pose, outside_workspace, ik_failed, "
-      "start_in_collision, goal_in_collision, no_path or timeout.",
+      "start_in_collision, goal_in_collision, no_path, timeout or (with --approach) approach_blocked.",
       "The scene is an OctoMap built from the last observation's point clouds (every camera's "
       "<camera>.points, inserted as rays from the camera so free space is known; unknown space "
       "counts as free), with the robot's own links and a held object filtered out, and an exact "

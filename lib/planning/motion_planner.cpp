@@ -200,10 +200,14 @@ PlanResult MotionPlanner::plan(const StartState& start, const Goal& goal, const 
   const Eigen::Isometry3d end_in_base =
       approach ? goal_in_base * Eigen::Translation3d(0, 0, -options_.approach_m) : goal_in_base;
   std::string failure, method;
-  const auto end_q = goal_configuration(start, end_in_base, scene, ik, failure);
-  if (!end_q) return failed(failure, t0);
   std::vector<robot::JointVector> approach_path;
-  if (approach && !straight_line(*end_q, goal_in_base, start.opening_m, approach_path)) return failed("no_path", t0);
+  const auto straight_approach = [&](const robot::JointVector& q) {
+    return straight_line(q, goal_in_base, start.opening_m, approach_path);
+  };
+  const auto end_q = goal_configuration(start, end_in_base, scene, ik, failure,
+                                        approach ? std::function<bool(const robot::JointVector&)>(straight_approach)
+                                                 : std::function<bool(const robot::JointVector&)>());
+  if (!end_q) return failed(failure, t0);
   std::vector<robot::JointVector> path = path_to(start, *end_q, scene, plan_index, method, failure);
   if (path.empty()) return failed(failure, t0);
   if (!approach) return finish(std::move(path), method, t0);
@@ -238,16 +242,19 @@ PlanResult MotionPlanner::plan_ignoring_scene(const StartState& start, const Eig
 std::optional<robot::JointVector> MotionPlanner::goal_configuration(const StartState& start,
                                                                     const Eigen::Isometry3d& goal_in_base,
                                                                     const OccupancyScene& scene, robot::IkOptions ik,
-                                                                    std::string& failure) const {
-  bool any_solution = false;
+                                                                    std::string& failure,
+                                                                    const std::function<bool(const robot::JointVector&)>& accept) const {
+  bool any_solution = false, any_free = false;
   for (int attempt = 0; attempt < 4; ++attempt) {
     ik.seed = derive_seed(ik.seed, attempt);
     const auto q = robot::solve_ik(robot_, goal_in_base, start.joints, ik);
     if (!q) break;
     any_solution = true;
-    if (checker_.state_valid(*q, start.opening_m, &scene)) return q;
+    if (!checker_.state_valid(*q, start.opening_m, &scene)) continue;
+    any_free = true;
+    if (!accept || accept(*q)) return q;
   }
-  failure = any_solution ? "goal_in_collision" : "ik_failed";
+  failure = any_free ? "approach_blocked" : any_solution ? "goal_in_collision" : "ik_failed";
   return std::nullopt;
 }
 

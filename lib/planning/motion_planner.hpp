@@ -34,7 +34,8 @@ struct PlannerOptions {
   // the pose approach_m back along the TCP's z axis on the whole sensed scene (the object to be
   // grasped an obstacle like any other), then a straight line to the goal checked against the
   // robot and the table, as a grasp approach. 0: planned to the goal itself, around which
-  // goal_free_radius_m is free space.
+  // goal_free_radius_m is free space. The straight approach enters the object on purpose, as
+  // an ignore_collisions move does; any move that closes an open gripper counts as a grasp.
   double approach_m = 0;
   CollisionCheckOptions collision;     // clearance, check step, the table (under its top is never free)
   uint64_t seed = 0;
@@ -50,7 +51,8 @@ struct Goal {
 
 struct PlanResult {
   std::string failure;  // empty on success: ik_failed, start_in_collision, goal_in_collision,
-                        // no_path, timeout, invalid_pose, outside_workspace
+                        // no_path, timeout, invalid_pose, outside_workspace, approach_blocked
+                        // (no straight approach to a grasp from any collision-free pose behind it)
   std::vector<double> time_s;
   std::vector<robot::JointVector> joint_positions;
   std::string method;   // direct, rrt_connect, straight_line
@@ -90,9 +92,10 @@ class MotionPlanner {
   // nearest collision-free IK solution); RRT-Connect between start and goal configurations.
   PlanResult plan_ignoring_scene(const StartState& start, const Eigen::Isometry3d& goal_in_base,
                                  robot::IkOptions ik, Clock::time_point t0) const;
-  std::optional<robot::JointVector> goal_configuration(const StartState& start, const Eigen::Isometry3d& goal_in_base,
-                                                       const OccupancyScene& scene, robot::IkOptions ik,
-                                                       std::string& failure) const;
+  // `accept` (if given) must also hold for the configuration: a grasp's straight approach.
+  std::optional<robot::JointVector> goal_configuration(
+      const StartState& start, const Eigen::Isometry3d& goal_in_base, const OccupancyScene& scene, robot::IkOptions ik,
+      std::string& failure, const std::function<bool(const robot::JointVector&)>& accept = {}) const;
   // A collision-free joint path from the start to goal_q: the direct line, else RRT-Connect
   // (shortcut); empty with `failure` set when there is none.
   std::vector<robot::JointVector> path_to(const StartState& start, const robot::JointVector& goal_q,

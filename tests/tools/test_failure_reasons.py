@@ -103,9 +103,11 @@ for want, observations, kind in reason_cases:
 if fr.reason({"obs": [step(), missed], "actions": []}, "elsewhere", grasping=False) != "out_of_steps":
     failures.append("a gripper closed on nothing in a task that needs no grasp counts as grasp_missed")
 if set(fr.REASONS) != {want for want, _, _ in reason_cases} | {"goal_in_collision", "no_path", "start_in_collision",
-                                                               "outside_workspace", "invalid_pose"}:
+                                                               "outside_workspace", "invalid_pose",
+                                                               "approach_blocked"}:
     failures.append(f"REASONS {fr.REASONS} and the cases tested differ")
-for failure in ("goal_in_collision", "ik_failed", "no_path", "start_in_collision", "outside_workspace", "invalid_pose"):
+for failure in ("goal_in_collision", "ik_failed", "no_path", "start_in_collision", "outside_workspace", "invalid_pose",
+                "approach_blocked"):
     if fr.action_reason(failure) != failure:  # plan-path's own names
         failures.append(f"plan-path's {failure}: {fr.action_reason(failure)}")
 
