@@ -201,12 +201,12 @@ PlanResult MotionPlanner::plan(const StartState& start, const Goal& goal, const 
       approach ? goal_in_base * Eigen::Translation3d(0, 0, -options_.approach_m) : goal_in_base;
   std::string failure, method;
   std::vector<robot::JointVector> approach_path;
-  const auto straight_approach = [&](const robot::JointVector& q) {
-    return straight_line(q, goal_in_base, start.opening_m, approach_path);
-  };
-  const auto end_q = goal_configuration(start, end_in_base, scene, ik, failure,
-                                        approach ? std::function<bool(const robot::JointVector&)>(straight_approach)
-                                                 : std::function<bool(const robot::JointVector&)>());
+  std::function<bool(const robot::JointVector&)> straight_approach;  // only with an approach
+  if (approach)
+    straight_approach = [&](const robot::JointVector& q) {
+      return straight_line(q, goal_in_base, start.opening_m, approach_path);
+    };
+  const auto end_q = goal_configuration(start, end_in_base, scene, ik, failure, straight_approach);
   if (!end_q) return failed(failure, t0);
   std::vector<robot::JointVector> path = path_to(start, *end_q, scene, plan_index, method, failure);
   if (path.empty()) return failed(failure, t0);
