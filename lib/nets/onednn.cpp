@@ -1,5 +1,6 @@
 #include "nets/onednn.hpp"
 
+#include <atomic>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
@@ -15,55 +16,108 @@ namespace {
 using dnnl::memory;
 using Dims = memory::dims;
 
-// One shape's swapped convolution: x viewed with batch and channels swapped as the input, dy
-// (swapped) as the kernel, the k^3 result reordered into LibTorch's [O, I, k, k, k].
-struct Swapped {
+// One shape's weight gradient. Where oneDNN has a vectorised kernel for the convolution's own
+// weight gradient here (AVX-512), that; otherwise (AVX2: only im2col + GEMM) the swapped
+// convolution: x viewed with batch and channels swapped as the input, dy (swapped) as the
+// kernel, the k^3 result reordered into LibTorch's [O, I, k, k, k]. Either way x and dy are
+// reordered into the layouts the primitive chose, where they differ.
+struct WeightGradient {
   memory::desc x, dy;
   int64_t padding;
-  memory::desc x_swapped, dy_swapped, dw_torch;
+  bool native_tried = false, native = false, vectorised = false;
+  memory::desc x_given, dy_given, dw_torch;  // x and dy as the caller holds them (swapped: permuted)
   Dims dw_sizes;
-  bool vectorised = false;
-  dnnl::convolution_forward::primitive_desc pd;
-  dnnl::convolution_forward convolution;
+  dnnl::primitive primitive;
+  memory::desc x_desc, dy_desc, dw_desc;  // the primitive's
   dnnl::reorder x_in, dy_in, dw_out;
+  int x_arg = DNNL_ARG_SRC, dy_arg = DNNL_ARG_DIFF_DST, dw_arg = DNNL_ARG_DIFF_WEIGHTS;
 };
 
-std::unique_ptr<Swapped> make_swapped(const memory::desc& x, const memory::desc& dy, int64_t p) {
+std::atomic<bool> native_on{true};
+
+bool jit(const dnnl::primitive_desc_base& pd) { return std::strncmp(pd.impl_info_str(), "jit", 3) == 0; }
+
+// oneDNN's own backward-weights primitive for the shape, in the layouts it prefers; false where
+// it has no vectorised kernel for it on this processor.
+bool make_native(WeightGradient& w, const Dims& kernel) {
   const auto f32 = memory::data_type::f32;
   const auto any = memory::format_tag::any;
-  auto s = std::make_unique<Swapped>();
-  s->x = x, s->dy = dy, s->padding = p;
-  const Dims xd = x.dims(), dyd = dy.dims();
-  const int64_t n = xd[0], i = xd[1], o = dyd[1];
-  const Dims kernel{xd[2] + 2 * p - dyd[2] + 1, xd[3] + 2 * p - dyd[3] + 1, xd[4] + 2 * p - dyd[4] + 1};
-  const int64_t k_volume = kernel[0] * kernel[1] * kernel[2];
-  s->x_swapped = x.permute_axes({1, 0, 2, 3, 4});
-  s->dy_swapped = dy.permute_axes({1, 0, 2, 3, 4});
-  s->dw_torch = memory::desc({i, o, kernel[0], kernel[1], kernel[2]}, f32,
-                             Dims{k_volume, i * k_volume, kernel[1] * kernel[2], kernel[2], 1});
-  s->dw_sizes = {o, i, kernel[0], kernel[1], kernel[2]};
+  const Dims xd = w.x.dims(), dyd = w.dy.dims(), strides{1, 1, 1}, pad{w.padding, w.padding, w.padding};
+  const memory::desc src(xd, f32, any), diff_dst(dyd, f32, any), weights(w.dw_sizes, f32, any);
+  try {
+    const dnnl::convolution_forward::primitive_desc hint(
+        {dnnl::prop_kind::forward_training, dnnl::algorithm::convolution_direct, src, weights, diff_dst, strides, pad,
+         pad},
+        engine());
+    const dnnl::convolution_backward_weights::primitive_desc pd(
+        {dnnl::algorithm::convolution_direct, src, weights, diff_dst, strides, pad, pad}, engine(), hint);
+    if (!jit(pd)) return false;
+    w.primitive = dnnl::convolution_backward_weights(pd);
+    w.x_desc = pd.src_desc(), w.dy_desc = pd.diff_dst_desc(), w.dw_desc = pd.diff_weights_desc();
+  } catch (const dnnl::error&) {
+    return false;
+  }
+  w.x_given = w.x, w.dy_given = w.dy;
+  w.dw_torch = memory::desc(w.dw_sizes, f32, memory::format_tag::oidhw);
+  return true;
+}
+
+void make_swapped(WeightGradient& w, const Dims& kernel) {
+  const auto f32 = memory::data_type::f32;
+  const auto any = memory::format_tag::any;
+  const Dims xd = w.x.dims(), dyd = w.dy.dims();
+  const int64_t n = xd[0], i = xd[1], o = dyd[1], k_volume = kernel[0] * kernel[1] * kernel[2], p = w.padding;
+  w.x_given = w.x.permute_axes({1, 0, 2, 3, 4});
+  w.dy_given = w.dy.permute_axes({1, 0, 2, 3, 4});
+  w.dw_torch = memory::desc({i, o, kernel[0], kernel[1], kernel[2]}, f32,
+                            Dims{k_volume, i * k_volume, kernel[1] * kernel[2], kernel[2], 1});
   const dnnl::convolution_forward::desc desc(
       dnnl::prop_kind::forward_inference, dnnl::algorithm::convolution_direct,
       memory::desc({i, n, xd[2], xd[3], xd[4]}, f32, any), memory::desc({o, n, dyd[2], dyd[3], dyd[4]}, f32, any),
       memory::desc({i, o, kernel[0], kernel[1], kernel[2]}, f32, any), Dims{1, 1, 1}, Dims{p, p, p}, Dims{p, p, p});
-  s->pd = dnnl::convolution_forward::primitive_desc(desc, engine());
-  s->vectorised = std::strncmp(s->pd.impl_info_str(), "jit", 3) == 0;
-  s->convolution = dnnl::convolution_forward(s->pd);
-  s->x_in = dnnl::reorder(dnnl::reorder::primitive_desc(engine(), s->x_swapped, engine(), s->pd.src_desc()));
-  s->dy_in = dnnl::reorder(dnnl::reorder::primitive_desc(engine(), s->dy_swapped, engine(), s->pd.weights_desc()));
-  s->dw_out = dnnl::reorder(dnnl::reorder::primitive_desc(engine(), s->pd.dst_desc(), engine(), s->dw_torch));
-  return s;
+  const dnnl::convolution_forward::primitive_desc pd(desc, engine());
+  w.vectorised = jit(pd);
+  w.primitive = dnnl::convolution_forward(pd);
+  w.x_desc = pd.src_desc(), w.dy_desc = pd.weights_desc(), w.dw_desc = pd.dst_desc();
+  w.x_arg = DNNL_ARG_SRC, w.dy_arg = DNNL_ARG_WEIGHTS, w.dw_arg = DNNL_ARG_DST;
 }
 
-// Created once per shape and layout (a network has a handful) and shared by the threads that train.
-const Swapped& swapped(const memory::desc& x, const memory::desc& dy, int64_t padding) {
+std::unique_ptr<WeightGradient> make_weight_gradient(const memory::desc& x, const memory::desc& dy, int64_t p,
+                                                     bool try_native) {
+  auto w = std::make_unique<WeightGradient>();
+  w->x = x, w->dy = dy, w->padding = p, w->native_tried = try_native;
+  const Dims xd = x.dims(), dyd = dy.dims();
+  const Dims kernel{xd[2] + 2 * p - dyd[2] + 1, xd[3] + 2 * p - dyd[3] + 1, xd[4] + 2 * p - dyd[4] + 1};
+  w->dw_sizes = {dyd[1], xd[1], kernel[0], kernel[1], kernel[2]};
+  w->native = w->vectorised = try_native && make_native(*w, kernel);
+  if (!w->native) make_swapped(*w, kernel);
+  w->x_in = dnnl::reorder(dnnl::reorder::primitive_desc(engine(), w->x_given, engine(), w->x_desc));
+  w->dy_in = dnnl::reorder(dnnl::reorder::primitive_desc(engine(), w->dy_given, engine(), w->dy_desc));
+  w->dw_out = dnnl::reorder(dnnl::reorder::primitive_desc(engine(), w->dw_desc, engine(), w->dw_torch));
+  return w;
+}
+
+// Created once per shape, layout and way (a network has a handful) and shared by the threads
+// that train.
+const WeightGradient& weight_gradient_for(const memory::desc& x, const memory::desc& dy, int64_t padding) {
   static std::mutex mutex;
-  static std::vector<std::unique_ptr<Swapped>> cache;
+  static std::vector<std::unique_ptr<WeightGradient>> cache;
+  const bool try_native = native_on;
   const std::lock_guard<std::mutex> lock(mutex);
-  for (const auto& s : cache)
-    if (s->x == x && s->dy == dy && s->padding == padding) return *s;
-  cache.push_back(make_swapped(x, dy, padding));
+  for (const auto& w : cache)
+    if (w->x == x && w->dy == dy && w->padding == padding && w->native_tried == try_native) return *w;
+  cache.push_back(make_weight_gradient(x, dy, padding, try_native));
   return *cache.back();
+}
+
+// `from` reordered by r into a new buffer of layout `to` (kept in `keep`), or `from` itself where
+// it already has that layout.
+memory reordered(const dnnl::stream& stream, const dnnl::reorder& r, memory from, const memory::desc& to,
+                 Buffer& keep) {
+  if (from.get_desc() == to) return from;
+  keep = buffer(to);
+  r.execute(stream, from, keep.memory);
+  return keep.memory;
 }
 
 }  // namespace
@@ -93,22 +147,28 @@ memory over(const torch::Tensor& storage, const memory::desc& desc) {
 }
 
 torch::Tensor weight_gradient(const memory& x, const memory& dy, int64_t padding) {
-  const Swapped& s = swapped(x.get_desc(), dy.get_desc(), padding);
+  const WeightGradient& w = weight_gradient_for(x.get_desc(), dy.get_desc(), padding);
   dnnl::stream stream(engine());
-  Buffer x_in = buffer(s.pd.src_desc()), dy_in = buffer(s.pd.weights_desc()), dw = buffer(s.pd.dst_desc());
-  auto result = torch::empty(s.dw_sizes, torch::kFloat);
-  memory x_swapped(s.x_swapped, engine(), x.get_data_handle()), dy_swapped(s.dy_swapped, engine(), dy.get_data_handle());
-  s.x_in.execute(stream, x_swapped, x_in.memory);
-  s.dy_in.execute(stream, dy_swapped, dy_in.memory);
-  s.convolution.execute(stream, {{DNNL_ARG_SRC, x_in.memory}, {DNNL_ARG_WEIGHTS, dy_in.memory}, {DNNL_ARG_DST, dw.memory}});
-  memory dw_torch = over(result, s.dw_torch);
-  s.dw_out.execute(stream, dw.memory, dw_torch);
+  Buffer x_keep, dy_keep, dw = buffer(w.dw_desc);
+  auto result = torch::empty(w.dw_sizes, torch::kFloat);
+  const memory x_given(w.x_given, engine(), x.get_data_handle()), dy_given(w.dy_given, engine(), dy.get_data_handle());
+  const memory x_in = reordered(stream, w.x_in, x_given, w.x_desc, x_keep);
+  const memory dy_in = reordered(stream, w.dy_in, dy_given, w.dy_desc, dy_keep);
+  w.primitive.execute(stream, {{w.x_arg, x_in}, {w.dy_arg, dy_in}, {w.dw_arg, dw.memory}});
+  memory dw_torch = over(result, w.dw_torch);
+  w.dw_out.execute(stream, dw.memory, dw_torch);
   stream.wait();
   return result;
 }
 
 bool weight_gradient_vectorised(const memory::desc& x, const memory::desc& dy, int64_t padding) {
-  return swapped(x, dy, padding).vectorised;
+  return weight_gradient_for(x, dy, padding).vectorised;
 }
+
+bool weight_gradient_native(const memory::desc& x, const memory::desc& dy, int64_t padding) {
+  return weight_gradient_for(x, dy, padding).native;
+}
+
+void use_native_weight_gradient(bool on) { native_on = on; }
 
 }  // namespace qte::nets::onednn

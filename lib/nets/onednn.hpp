@@ -1,6 +1,6 @@
 // oneDNN used directly by the networks (the library LibTorch itself runs its convolutions with,
 // from Debian): one CPU engine, buffers owned by tensors, and the weight gradient of a 3D
-// convolution computed as a forward convolution (nets/conv3d.hpp says why).
+// convolution by whichever of two ways oneDNN has a vectorised kernel for on this processor.
 #pragma once
 
 #include <oneapi/dnnl/dnnl.hpp>
@@ -27,9 +27,16 @@ dnnl::memory over(const torch::Tensor& storage, const dnnl::memory::desc& desc);
 
 // The weight gradient [O, I, k, k, k] (LibTorch's layout) of a stride-1 3D convolution padded by
 // `padding` on every side, from its input x [N, I, ...] and output gradient dy [N, O, ...], each
-// in any layout oneDNN knows.
+// in any layout oneDNN knows. Computed by oneDNN's own backward-weights primitive where it has a
+// vectorised kernel for the shape on this processor (AVX-512 machines), otherwise as a forward
+// convolution with batch and channels swapped (nets/conv3d.hpp says why: AVX2 machines).
 torch::Tensor weight_gradient(const dnnl::memory& x, const dnnl::memory& dy, int64_t padding);
-// Whether oneDNN has a vectorised kernel for that computation on this processor.
+// Whether oneDNN has a vectorised kernel for that computation on this processor, and whether it
+// is oneDNN's own backward-weights primitive (not the swapped convolution).
 bool weight_gradient_vectorised(const dnnl::memory::desc& x, const dnnl::memory::desc& dy, int64_t padding);
+bool weight_gradient_native(const dnnl::memory::desc& x, const dnnl::memory::desc& dy, int64_t padding);
+// Off, weight_gradient always computes the swapped convolution (default on); the tests and
+// benchmarks compare the two in one process.
+void use_native_weight_gradient(bool on);
 
 }  // namespace qte::nets::onednn

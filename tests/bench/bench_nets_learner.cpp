@@ -12,7 +12,8 @@
 //   interleaved step by step, so that a noisy machine hits both alike; prints the ratio.
 //   --compare-layers 1: instead, plain full steps with LibTorch's layers, with LibTorch's layers
 //   but the swapped weight gradient (nets/conv3d.hpp), and with the oneDNN trunk
-//   (nets/light_trunk.hpp, the default), interleaved step by step; prints the ratios.
+//   (nets/light_trunk.hpp, the default; where it uses oneDNN's own weight-gradient kernel,
+//   AVX-512, also with the swapped one), interleaved step by step; prints the ratios.
 //   --every-sample-bootstraps 1: every sample its own next state (discount gamma, no shared
 //   states), the targets' worst case; by default the demonstrations' chains end and share
 //   keyframes, and the targets evaluate each next state once (the mean count is printed).
@@ -33,6 +34,7 @@
 #include "nets/conv3d.hpp"
 #include "light_layers.hpp"
 #include "nets/light_trunk.hpp"
+#include "nets/onednn.hpp"
 #include "nets/qattention_modules.hpp"
 #include "replay/replay_buffer.hpp"
 
@@ -86,24 +88,29 @@ int main(int argc, char** argv) {
     struct Variant {
       const char* name;
       int tree;
-      bool swapped, onednn;
+      bool swapped, onednn, native;
       std::unique_ptr<learner::QLearner> learner;
       std::vector<double> seconds;
     };
     std::vector<Variant> variants;
-    const auto add = [&](const char* name, int k, bool swapped, bool onednn) {
+    const auto add = [&](const char* name, int k, bool swapped, bool onednn, bool native) {
       learner::LearnerConfig c = config;
       c.tree_target_k = k;
       nets::seed_torch(1);
-      variants.push_back({name, k, swapped, onednn, std::make_unique<learner::QLearner>(c), {}});
+      variants.push_back({name, k, swapped, onednn, native, std::make_unique<learner::QLearner>(c), {}});
     };
     if (compare_layers) {
-      add("LibTorch's layers", tree, false, false);
-      add("+ swapped weight gradient", tree, true, false);
-      add("oneDNN trunk", tree, true, true);
+      add("LibTorch's layers", tree, false, false, false);
+      add("+ swapped weight gradient", tree, true, false, false);
+      add("oneDNN trunk", tree, true, true, true);
+      const auto desc = [](int channels) {
+        return dnnl::memory::desc({32, channels, 8, 8, 8}, dnnl::memory::data_type::f32, dnnl::memory::format_tag::ncdhw);
+      };
+      if (nets::onednn::weight_gradient_native(desc(16), desc(32), 1))
+        add("oneDNN trunk, swapped dW", tree, true, true, false);
     } else {
-      add("plain targets", 0, true, true);
-      add("tree targets", compare, true, true);
+      add("plain targets", 0, true, true, true);
+      add("tree targets", compare, true, true, true);
     }
     double states = 0;  // next states the targets evaluate, summed over the timed steps
     for (int step = 0; step <= steps; ++step)  // step 0 warms up
@@ -111,6 +118,7 @@ int main(int argc, char** argv) {
         std::mt19937_64 rng(step);
         nets::use_swapped_weight_gradient(v.swapped);
         nets::use_onednn_trunk(v.onednn);
+        nets::onednn::use_native_weight_gradient(v.native);
         const auto t0 = Clock::now();
         const replay::Sample sample = replay.sample(batch, 1.0, rng);
         learner::Minibatch mb = learner::assemble_minibatch(replay, sample, config);
@@ -129,6 +137,7 @@ int main(int argc, char** argv) {
     for (const Variant& v : variants)
       std::printf("  %-26s K=%-2d %.3f s  (%.2fx the first; %.2fx as fast)\n", v.name, v.tree, median(v.seconds),
                   median(v.seconds) / median(variants[0].seconds), median(variants[0].seconds) / median(v.seconds));
+    nets::onednn::use_native_weight_gradient(true);
     return 0;
   }
 

@@ -1,6 +1,8 @@
 // `light`'s convolutional trunk (lib/nets/qattention_modules.cpp, LightNet) three ways, alternated
 // run by run in one process: LibTorch's layers; LibTorch's layers with the swapped weight
-// gradient (nets/conv3d.hpp); the trunk run by oneDNN alone (nets/light_trunk.hpp, the default).
+// gradient (nets/conv3d.hpp); the trunk run by oneDNN alone (nets/light_trunk.hpp, the default),
+// and, where oneDNN has its own vectorised weight-gradient kernel here (AVX-512), the trunk
+// with the swapped weight gradient instead (nets/onednn.hpp).
 // For each: the training forward, forward + backward (the backward reaching every parameter, as
 // in a learner step: a loss on the Q values and, at the last depth, on the head's levels) and
 // the no-gradient forward, at the training batch (32), a tree expansion's branches (20) and
@@ -25,6 +27,7 @@
 #include "machine_peak.hpp"
 #include "nets/conv3d.hpp"
 #include "nets/light_trunk.hpp"
+#include "nets/onednn.hpp"
 #include "nets/qattention_modules.hpp"
 
 namespace {
@@ -38,7 +41,7 @@ double median(std::vector<double> v) {
 
 struct Way {
   const char* name;
-  bool swapped, onednn;
+  bool swapped, onednn, native;
   std::vector<double> forward, training, inference;
 };
 
@@ -92,6 +95,12 @@ int main(int argc, char** argv) {
   // The peak, before and after the timings (the larger: a virtual machine's varies by a fifth).
   qte::bench::Peak peak = qte::bench::measure_fp32_peak(threads);
   const int depths = 2;
+  // Whether oneDNN's own weight-gradient kernel is used on this processor (asked for down1.0's
+  // shape; the choice is the processor's, not the layer's).
+  const auto desc = [](int channels) {
+    return dnnl::memory::desc({32, channels, 8, 8, 8}, dnnl::memory::data_type::f32, dnnl::memory::format_tag::ncdhw);
+  };
+  const bool native_here = qte::nets::onednn::weight_gradient_native(desc(16), desc(32), 1);
   double trunk_s = 0;
   std::vector<std::pair<std::string, Breakdown>> breakdowns;  // printed at the end, against the peak
   std::printf("light's trunk (16^3 grid, 10 channels, 16 base channels), %d threads, median of %d, alternated\n",
@@ -104,14 +113,16 @@ int main(int argc, char** argv) {
       const auto grid = torch::rand({batch, config.channels, config.voxels, config.voxels, config.voxels});
       const auto proprio = torch::rand({batch, config.proprio});
       Breakdown breakdown;
-      std::vector<Way> ways{{"LibTorch's layers", false, false, {}, {}, {}},
-                            {"+ swapped weight gradient", true, false, {}, {}, {}},
-                            {"oneDNN trunk", true, true, {}, {}, {}}};
+      std::vector<Way> ways{{"LibTorch's layers", false, false, false, {}, {}, {}},
+                            {"+ swapped weight gradient", true, false, false, {}, {}, {}},
+                            {"oneDNN trunk", true, true, true, {}, {}, {}}};
+      if (native_here) ways.push_back({"oneDNN trunk, swapped dW", true, true, false, {}, {}, {}});
       if (only_onednn) ways.erase(ways.begin(), ways.begin() + 2);
       for (int r = 0; r <= reps; ++r)  // r = 0 warms up (primitives created, buffers allocated)
         for (Way& w : ways) {
           qte::nets::use_swapped_weight_gradient(w.swapped);
           qte::nets::use_onednn_trunk(w.onednn);
+          qte::nets::onednn::use_native_weight_gradient(w.native);
           net->zero_grad();
           const qte::nets::TrunkTime before = qte::nets::light_trunk_time();
           auto t0 = Clock::now();
@@ -121,7 +132,7 @@ int main(int argc, char** argv) {
           for (const auto& level : trunk.levels) loss = loss + level.mean();
           loss.backward();
           const double training = std::chrono::duration<double>(Clock::now() - t0).count();
-          if (w.onednn && r > 0) breakdown.add(before, qte::nets::light_trunk_time());
+          if (w.onednn && w.native && r > 0) breakdown.add(before, qte::nets::light_trunk_time());
           t0 = Clock::now();
           {
             torch::NoGradGuard no_grad;
@@ -157,5 +168,6 @@ int main(int argc, char** argv) {
               peak.isa.c_str());
   qte::nets::use_swapped_weight_gradient(true);
   qte::nets::use_onednn_trunk(true);
+  qte::nets::onednn::use_native_weight_gradient(true);
   return 0;
 }

@@ -1,8 +1,10 @@
-// The swapped weight gradient (nets/conv3d.hpp) against a brute-force sum written here and
-// against LibTorch's own backward, alone and through a whole network.
+// The weight gradient (nets/conv3d.hpp, nets/onednn.hpp: oneDNN's own kernel where it has a
+// vectorised one, the swapped convolution otherwise) against a brute-force sum written here, both
+// ways, and against LibTorch's own backward, alone and through a whole network.
 #include <gtest/gtest.h>
 
 #include "nets/conv3d.hpp"
+#include "nets/onednn.hpp"
 #include "nets/qattention_modules.hpp"
 
 namespace qte::nets {
@@ -52,8 +54,13 @@ TEST(Conv3dWeightGradient, EqualsTheBruteForceSum) {
     const int64_t od = c.d + 2 * c.padding - c.kernel + 1, oh = c.h + 2 * c.padding - c.kernel + 1,
                   ow = c.w + 2 * c.padding - c.kernel + 1;
     const auto dy = torch::randn({c.n, c.out, od, oh, ow});
-    expect_close(conv3d_weight_gradient(x, dy, c.padding), brute_force_weight_gradient(x, dy, c.padding), 1e-5,
-                 "weight gradient");
+    const auto expected = brute_force_weight_gradient(x, dy, c.padding);
+    for (const bool native : {true, false}) {
+      onednn::use_native_weight_gradient(native);
+      expect_close(conv3d_weight_gradient(x, dy, c.padding), expected, 1e-5,
+                   native ? "weight gradient, oneDNN's kernel where it has one" : "weight gradient, swapped");
+    }
+    onednn::use_native_weight_gradient(true);
   }
 }
 
