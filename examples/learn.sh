@@ -76,6 +76,12 @@ if [ -f "$run/plan_options" ]; then
 else
   echo "$PLAN_OPTIONS" > "$run/plan_options"
 fi
+# The processor the run ran on, a line per start (a resumed run may move): under CPU_BUDGET a
+# faster processor buys more learner steps, so comparisons pair runs made on one kind.
+vector_isa=$(grep -m1 -ow 'avx512f\|avx2' /proc/cpuinfo | sort | tail -n1)
+cpu_field() { sed -n "s/^$1[[:space:]]*: //p" /proc/cpuinfo | head -n1; }
+echo "$(date -u +%FT%TZ),$(cpu_field 'model name') (family $(cpu_field 'cpu family') model $(cpu_field model)),${vector_isa:-sse},$(nproc)" \
+  >> "$run/machine"
 # The script's own waiting costs no process (it is counted in the budget, and a method that
 # takes longer would pay more for it): a read with a timeout on a FIFO nobody writes.
 [ -p "$run/actors/.tick" ] || mkfifo "$run/actors/.tick"

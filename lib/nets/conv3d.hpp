@@ -11,8 +11,9 @@
 // is a forward convolution of an input with batch i and channels n (X, swapped) by a kernel with
 // outputs o, inputs n and the spatial size of dY, padded by p, giving a k^3 output. oneDNN runs
 // that forward with its vectorised kernel (3-4x the GEMM path's speed on AVX2, same sums in
-// another order). oneDNN chooses the kernel for the processor at run time; where it offers only
-// its reference or GEMM code for this forward, LibTorch's own weight gradient is used instead.
+// another order). Where oneDNN does have a vectorised weight-gradient kernel (AVX-512), that is
+// used instead (nets/onednn.hpp). oneDNN chooses the kernels for the processor at run time; where
+// it offers only its reference or GEMM code for both, LibTorch's own weight gradient is used.
 #pragma once
 
 #include <torch/torch.h>
