@@ -28,7 +28,10 @@ target), to set beside the chance of picking among the task's lookalikes. --pair
 compares every other label with the label BASELINE, paired by seed (the seeds both have): the
 mean difference in final success, its 95% interval (Student's t over the paired differences),
 and the two-sided p-value of the exact sign-flip permutation test (all 2^n sign assignments of
-the n differences; the test makes no assumption about their distribution). --acting sums
+the n differences; the test makes no assumption about their distribution), and how many of the
+pairs were made on one processor (pairs_one_processor: both runs' machines/ files, learn.sh's
+record copied beside the CSVs, name the same model and vector width; under a processor-time
+budget a faster processor buys more learner steps). --acting sums
 failure_reasons CSVs per task, label (how the networks were trained) and the K they acted with:
 from the name's _act-kK suffix (learn.sh's ALSO_ACT_K), else the label's own (LABEL = ...-kK-...).
 --reasons sums the episodes' reasons (why each failed: failure_reasons.py's columns) the same
@@ -170,11 +173,24 @@ def curves(paths, task):
     writer.writerows(rows)
 
 
+def processor_of(path):
+    """The processor a run's CSV was made on: "model,vector_isa" from machines/NAME beside it
+    (examples/Makefile copies learn.sh's machine file there: started_utc,model,vector_isa,cores a
+    line per start), "mixed" if its starts differ, "" where none was recorded."""
+    machine = os.path.join(os.path.dirname(path), "machines", os.path.basename(path))
+    try:
+        with open(machine) as f:
+            starts = {",".join(line.strip().split(",")[1:-1]) for line in f if line.strip()}
+    except OSError:
+        return ""
+    return starts.pop() if len(starts) == 1 else ("mixed" if starts else "")
+
+
 def final_rows(paths):
     runs = defaultdict(list)  # (task, label) -> final row of each run, in the order given
-    for task, rows in evaluations(paths):
+    for path, (task, rows) in zip(paths, evaluations(paths)):
         last = max(rows, key=lambda r: float(r["eval_point"]))
-        runs[(task, last["label"])].append({"task": task, **last})
+        runs[(task, last["label"])].append({"task": task, **last, "processor": processor_of(path)})
     return runs
 
 
@@ -237,6 +253,7 @@ def paired(runs, baseline):
         if not pairs:
             continue
         d = [float(a["success_rate"]) - float(b["success_rate"]) for a, b in pairs]
+        one_processor = sum(a["processor"] not in ("", "mixed") and a["processor"] == b["processor"] for a, b in pairs)
         mean = statistics.mean(d)
         half = t_quantile(0.975, len(d) - 1) * statistics.stdev(d) / math.sqrt(len(d)) if len(d) > 1 else float("nan")
         table.append({
@@ -250,6 +267,7 @@ def paired(runs, baseline):
             "ci95_low": f"{mean - half:+.3f}" if len(d) > 1 else "",  # no interval from one pair
             "ci95_high": f"{mean + half:+.3f}" if len(d) > 1 else "",
             "sign_flip_p": f"{sign_flip_p(d):.4f}",
+            "pairs_one_processor": one_processor,
             "per_seed": " ".join(f"s{a['seed']}:{x:+.2f}" for (a, _), x in zip(pairs, d)),
         })
     return table

@@ -176,6 +176,22 @@ def main():
         p_value = sum(v >= 0.30 - 1e-12 for v in sums) / 32
         assert p_value == 6 / 32 and pair[0]["sign_flip_p"] == "0.1875", (pair, p_value)
         assert pair[0]["per_seed"] == "s0:+0.08 s1:+0.04 s2:+0.12 s3:-0.04 s4:+0.10", pair
+        assert pair[0]["pairs_one_processor"] == "0", pair  # no machines/ files: none known
+
+        # Pairs made on one processor, from learn.sh's machine files in machines/: seeds 0 and 1
+        # both runs on one (seed 1's QTE run resumed on it), seed 2 on two kinds, seed 3's C2F-ARM
+        # run resumed on another kind (mixed), seed 4 only QTE's recorded.
+        zen4, zen3 = "AMD EPYC (family 25 model 17),avx512f,2", "AMD EPYC (family 25 model 1),avx2,2"
+        os.makedirs(os.path.join(d, "machines"))
+        for name, starts in [("c2farm-k1-t0-seed0", [zen4]), ("qte-k10-t10-seed0", [zen4]),
+                             ("c2farm-k1-t0-seed1", [zen4]), ("qte-k10-t10-seed1", [zen4, zen4]),
+                             ("c2farm-k1-t0-seed2", [zen3]), ("qte-k10-t10-seed2", [zen4]),
+                             ("c2farm-k1-t0-seed3", [zen4, zen3]), ("qte-k10-t10-seed3", [zen4]),
+                             ("qte-k10-t10-seed4", [zen4])]:
+            with open(os.path.join(d, "machines", f"reach_prism_{name}.csv"), "w") as f:
+                f.writelines(f"2026-11-27T04:0{i}:00Z,{start}\n" for i, start in enumerate(starts))
+        pair = rows_of(run("--paired", "c2farm-k1-t0", *mine).stdout)
+        assert pair[0]["pairs_one_processor"] == "2", pair
 
         # Trained-by x acting-with: a run's own failures (its label's K) and those acting with
         # another K (learn.sh's ALSO_ACT_K, named ..._act-kK.csv) kept apart, summed over seeds.
