@@ -103,10 +103,7 @@ int main(int argc, char** argv) {
       add("LibTorch's layers", tree, false, false, false);
       add("+ swapped weight gradient", tree, true, false, false);
       add("oneDNN trunk", tree, true, true, true);
-      const auto desc = [](int channels) {
-        return dnnl::memory::desc({32, channels, 8, 8, 8}, dnnl::memory::data_type::f32, dnnl::memory::format_tag::ncdhw);
-      };
-      if (nets::onednn::weight_gradient_native(desc(16), desc(32), 1))
+      if (bench::native_weight_gradient_here())
         add("oneDNN trunk, swapped dW", tree, true, true, false);
     } else {
       add("plain targets", 0, true, true, true);

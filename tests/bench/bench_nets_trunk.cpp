@@ -95,12 +95,7 @@ int main(int argc, char** argv) {
   // The peak, before and after the timings (the larger: a virtual machine's varies by a fifth).
   qte::bench::Peak peak = qte::bench::measure_fp32_peak(threads);
   const int depths = 2;
-  // Whether oneDNN's own weight-gradient kernel is used on this processor (asked for down1.0's
-  // shape; the choice is the processor's, not the layer's).
-  const auto desc = [](int channels) {
-    return dnnl::memory::desc({32, channels, 8, 8, 8}, dnnl::memory::data_type::f32, dnnl::memory::format_tag::ncdhw);
-  };
-  const bool native_here = qte::nets::onednn::weight_gradient_native(desc(16), desc(32), 1);
+  const bool native_here = qte::bench::native_weight_gradient_here();
   double trunk_s = 0;
   std::vector<std::pair<std::string, Breakdown>> breakdowns;  // printed at the end, against the peak
   std::printf("light's trunk (16^3 grid, 10 channels, 16 base channels), %d threads, median of %d, alternated\n",

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "nets/onednn.hpp"
 #include "nets/qattention_net.hpp"
 
 namespace qte::bench {
@@ -52,6 +53,16 @@ inline TrunkFlops light_trunk_flops() {
     first = false;
   }
   return f;
+}
+
+// Whether the weight gradients run by oneDNN's own backward-weights kernel on this processor
+// (nets/onednn.hpp), asked for down1.0's shape at batch 32: the choice is the processor's, not
+// the layer's.
+inline bool native_weight_gradient_here() {
+  const auto desc = [](int channels) {
+    return dnnl::memory::desc({32, channels, 8, 8, 8}, dnnl::memory::data_type::f32, dnnl::memory::format_tag::ncdhw);
+  };
+  return nets::onednn::weight_gradient_native(desc(16), desc(32), 1);
 }
 
 }  // namespace qte::bench
