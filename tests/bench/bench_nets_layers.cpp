@@ -7,9 +7,10 @@
 // threads. For each: milliseconds, GFLOP/s (2 FLOPs a multiply-accumulate; the backward
 // computes input and weight gradients, twice the forward's, except the first layer's: its
 // input is the grid, which needs no gradient) and the share of the machine's fp32 peak
-// measured on as many threads (machine_peak.hpp). The backward is the networks' own (the
-// swapped weight gradient, nets/conv3d.hpp); LibTorch's backward of the same layer is timed
-// beside it (last column). Element-wise layers (LeakyReLU,
+// measured on as many threads (machine_peak.hpp). The backward is the networks' own (the weight
+// gradient by oneDNN's own kernel where it has a vectorised one, swapped otherwise:
+// nets/conv3d.hpp, nets/onednn.hpp); LibTorch's backward of the same layer is timed beside it
+// (last column). Element-wise layers (LeakyReLU,
 // pooling, upsampling) are not listed: their cost is the difference between the sum here and
 // bench_nets_learner's step.
 // Options: --threads N (only N), --reps R (median of R, default 5), --batch B (default 32).
