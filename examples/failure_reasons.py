@@ -32,6 +32,9 @@ and has one reason (REASONS), the first cause in the episode that explains the f
                        held an object that is no target and never held a target afterwards
   then, in the order they happened, the first of these not made good by a later grasp that
   held a target:
+    pushed             the gripper closed and held nothing, on a task that needs a grasp, and
+                       the move that closed it shifted a target or distractor by over 1 cm (the
+                       way in swept into it; with the simulator's objects only)
     grasp_missed       the gripper closed and held nothing, on a task that needs a grasp (the
                        expert holds an object on the scene; always when sorting one stream)
     dropped            the gripper opened on a target it held (let go of it, or put it where
@@ -70,6 +73,7 @@ from ambiguity import box_centre, object_at, objects, task_objects  # noqa: E402
 NEAR_M = 0.04  # from a group of points (streams without objects)
 MARGIN_M = 0.02  # around an object's bounding box (with the simulator's objects)
 HOLDING_M = 0.001  # fingers closed this far apart or more stopped on something (streams without objects.held)
+PUSHED_M = 0.01  # an object moved this far by the move that closed the gripper on nothing: pushed
 
 
 def scalar(record, name, default=None):
@@ -167,7 +171,7 @@ def classify(expert, agent):
     return ("distractor" if chosen != target else "target"), distance, failure
 
 
-REASONS = ["success", "wrong_object", "grasp_missed", "dropped", "goal_in_collision", "ik_failed", "no_path",
+REASONS = ["success", "wrong_object", "pushed", "grasp_missed", "dropped", "goal_in_collision", "ik_failed", "no_path",
            "start_in_collision", "outside_workspace", "invalid_pose", "approach_blocked", "trajectory_refused", "collision",
            "other_failure", "out_of_steps"]
 PLANNER_FAILURES = {"goal_in_collision", "ik_failed", "no_path", "start_in_collision", "outside_workspace",
@@ -200,6 +204,16 @@ def held_role(obs):
     return on.role if on is not None else "target"
 
 
+def shifted(before, after):
+    """Whether a target or distractor moved over PUSHED_M between two observations (False for
+    streams without the simulator's objects)."""
+    was, now = scene_objects(before), scene_objects(after)
+    if not was or not now or len(was) != len(now):
+        return False
+    return any(a.role in ("target", "distractor") and np.linalg.norm(np.asarray(b.pose[:3]) - np.asarray(a.pose[:3])) > PUSHED_M
+               for a, b in zip(was, now))
+
+
 def holds_something(observations):
     """Whether the gripper holds an object in any of the observations (the expert's, on a
     task that needs a grasp)."""
@@ -224,7 +238,7 @@ def reason(episode, kind, grasping=True):
             elif now is not None:
                 pending.append("wrong_object")
             elif grasping:
-                pending.append("grasp_missed")
+                pending.append("pushed" if shifted(before, after) else "grasp_missed")
         elif holding == "target" and now is None:
             pending.append("dropped")
         failure = scalar(after, "failure", "")

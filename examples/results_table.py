@@ -82,10 +82,10 @@ def failures(paths):
 
 # failure_reasons.py's reasons, the columns after failed_actions (success has its own column);
 # those added later count 0 in the CSVs written before them.
-REASONS = ["wrong_object", "grasp_missed", "dropped", "goal_in_collision", "ik_failed", "no_path",
+REASONS = ["wrong_object", "pushed", "grasp_missed", "dropped", "goal_in_collision", "ik_failed", "no_path",
            "start_in_collision", "outside_workspace", "invalid_pose", "approach_blocked", "trajectory_refused",
            "collision", "other_failure", "out_of_steps"]
-LATER_REASONS = {"approach_blocked"}
+LATER_REASONS = {"approach_blocked", "pushed"}
 
 
 def reasons(paths):

@@ -102,7 +102,7 @@ for want, observations, kind in reason_cases:
         failures.append(f"reason: expected {want}, got {got} ({kind}, {len(observations)} observations)")
 if fr.reason({"obs": [step(), missed], "actions": []}, "elsewhere", grasping=False) != "out_of_steps":
     failures.append("a gripper closed on nothing in a task that needs no grasp counts as grasp_missed")
-if set(fr.REASONS) != {want for want, _, _ in reason_cases} | {"goal_in_collision", "no_path", "start_in_collision",
+if set(fr.REASONS) != {want for want, _, _ in reason_cases} | {"pushed", "goal_in_collision", "no_path", "start_in_collision",
                                                                "outside_workspace", "invalid_pose",
                                                                "approach_blocked"}:
     failures.append(f"REASONS {fr.REASONS} and the cases tested differ")
@@ -130,6 +130,23 @@ for want, o in [("target", with_objects((0.3, 0.3))), ("distractor", with_object
         failures.append(f"held_role: expected {want}, got {fr.held_role(o)}")
 if [o.held for o in fr.scene_objects(with_objects((0.3, 0.3)))] != [None, None]:
     failures.append("scene_objects without objects.held: held is not None")
+
+# A grasp that held nothing is `pushed` when the move that closed the gripper shifted a target or
+# distractor by over 1 cm, else grasp_missed; an `other` object moving does not count.
+def closing_on_nothing(moved, dx, role=1):
+    before, after = with_objects((0.3, 0.3), [0, 0]), with_objects((0.3, 0.3), [0, 0])
+    before.fields["gripper_open"] = np.array(1, np.uint8)
+    after.fields["objects.role"] = before.fields["objects.role"] = np.array([role, 2], np.uint8)
+    after.fields["objects.pose"] = after.fields["objects.pose"].copy()
+    after.fields["objects.pose"][moved, 0] += dx
+    return {"obs": [before, after], "actions": []}
+
+
+for want, moved, dx, role in [("pushed", 0, 0.03, 1), ("pushed", 1, -0.02, 1), ("grasp_missed", 0, 0.005, 1),
+                              ("grasp_missed", 0, 0.03, 0)]:
+    got = fr.reason(closing_on_nothing(moved, dx, role), "target")
+    if got != want:
+        failures.append(f"object {moved} (role {role}) moved {100 * dx:+.1f} cm by a grasp on nothing: expected {want}, got {got}")
 
 if failures:
     sys.exit("FAIL: " + "; ".join(failures))

@@ -90,11 +90,11 @@ got=$(sed 's/^episode [0-9]*: \([a-z_]*\) .*/\1/' "$tmp/known.err" | tr '\n' ' '
 [ "$got" = "${reasons[*]} " ] || fail "reasons: expected ${reasons[*]}, got $got ($(cat "$tmp/known.err"))"
 grep -q "^episode 6: collision .*collision:.*-table" "$tmp/known.err" || fail "the move into the table: $(cat "$tmp/known.err")"
 grep -c "the expert: success$" "$tmp/known.err" | grep -qx 8 || fail "the expert's reason per scene: $(cat "$tmp/known.err")"
-expected='label,seed,episodes,success,distractor,target,elsewhere,failed_actions,wrong_object,grasp_missed,dropped,goal_in_collision,ik_failed,no_path,start_in_collision,outside_workspace,invalid_pose,approach_blocked,trajectory_refused,collision,other_failure,out_of_steps
-known,,8,1,1,1,5,3,1,1,1,1,0,0,0,0,0,0,1,1,0,1'
+expected='label,seed,episodes,success,distractor,target,elsewhere,failed_actions,wrong_object,pushed,grasp_missed,dropped,goal_in_collision,ik_failed,no_path,start_in_collision,outside_workspace,invalid_pose,approach_blocked,trajectory_refused,collision,other_failure,out_of_steps
+known,,8,1,1,1,5,3,1,0,1,1,1,0,0,0,0,0,0,1,1,0,1'
 [ "$(cat "$tmp/known.csv")" = "$expected" ] || fail "the counts: $(cat "$tmp/known.csv")"
 # The expert's stream alone: its own episode, sorted by its objects.
-$py "$src/examples/failure_reasons.py" --label expert "$tmp/expert.rec" | tail -1 | grep -q "^expert,,1,1,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0$" \
+$py "$src/examples/failure_reasons.py" --label expert "$tmp/expert.rec" | tail -1 | grep -q "^expert,,1,1,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0$" \
   || fail "the expert alone: $($py "$src/examples/failure_reasons.py" "$tmp/expert.rec" 2>&1)"
 
 # --- the expert's episodes recorded once per key --------------------------------------------
