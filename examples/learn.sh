@@ -78,7 +78,7 @@ else
 fi
 # The processor the run ran on, a line per start (a resumed run may move): under CPU_BUDGET a
 # faster processor buys more learner steps, so comparisons pair runs made on one kind.
-vector_isa=$(grep -m1 -ow 'avx512f\|avx2' /proc/cpuinfo | sort | tail -n1)
+vector_isa=$(grep -m1 -ow 'avx512f\|avx2' /proc/cpuinfo | sort | tail -n1 || true)
 cpu_field() { sed -n "s/^$1[[:space:]]*: //p" /proc/cpuinfo | head -n1; }
 echo "$(date -u +%FT%TZ),$(cpu_field 'model name') (family $(cpu_field 'cpu family') model $(cpu_field model)),${vector_isa:-sse},$(nproc)" \
   >> "$run/machine"
