@@ -208,7 +208,7 @@ def shifted(before, after):
     """Whether a target or distractor moved over PUSHED_M between two observations (False for
     streams without the simulator's objects)."""
     was, now = scene_objects(before), scene_objects(after)
-    if not was or not now or len(was) != len(now):
+    if not was or not now or [o.name for o in was] != [o.name for o in now]:
         return False
     return any(a.role in ("target", "distractor") and np.linalg.norm(np.asarray(b.pose[:3]) - np.asarray(a.pose[:3])) > PUSHED_M
                for a, b in zip(was, now))

@@ -76,12 +76,17 @@ if [ -f "$run/plan_options" ]; then
 else
   echo "$PLAN_OPTIONS" > "$run/plan_options"
 fi
-# The processor the run ran on, a line per start (a resumed run may move): under CPU_BUDGET a
-# faster processor buys more learner steps, so comparisons pair runs made on one kind.
-vector_isa=$(grep -m1 -ow 'avx512f\|avx2' /proc/cpuinfo | sort | tail -n1 || true)
-cpu_field() { sed -n "s/^$1[[:space:]]*: //p" /proc/cpuinfo | head -n1; }
-echo "$(date -u +%FT%TZ),$(cpu_field 'model name') (family $(cpu_field 'cpu family') model $(cpu_field model)),${vector_isa:-sse},$(nproc)" \
-  >> "$run/machine"
+# The processor the run ran on, a line (started_utc,model,vector_isa,cores) when a start finds
+# another than the last line names (a run resumed elsewhere): under CPU_BUDGET a faster
+# processor buys more learner steps, so comparisons pair runs made on one kind. Actors of a
+# split run (ROLE=actor) leave it to the learner's side.
+cpu_field() { sed -n "s/^$1[[:space:]]*: //p" /proc/cpuinfo 2>/dev/null | head -n1; }
+vector_isa=$(grep -m1 -ow 'avx512f\|avx2' /proc/cpuinfo 2>/dev/null | sort | tail -n1 || true)
+model=$(cpu_field 'model name')
+processor="${model:-$(uname -m)} (family $(cpu_field 'cpu family') model $(cpu_field model)),${vector_isa:-other},$(nproc)"
+if [ "$ROLE" != actor ] && [ "$(tail -n1 "$run/machine" 2>/dev/null | cut -d, -f2-)" != "$processor" ]; then
+  echo "$(date -u +%FT%TZ),$processor" >> "$run/machine"
+fi
 # The script's own waiting costs no process (it is counted in the budget, and a method that
 # takes longer would pay more for it): a read with a timeout on a FIFO nobody writes.
 [ -p "$run/actors/.tick" ] || mkfifo "$run/actors/.tick"

@@ -35,7 +35,8 @@ budget a faster processor buys more learner steps). --acting sums
 failure_reasons CSVs per task, label (how the networks were trained) and the K they acted with:
 from the name's _act-kK suffix (learn.sh's ALSO_ACT_K), else the label's own (LABEL = ...-kK-...).
 --reasons sums the episodes' reasons (why each failed: failure_reasons.py's columns) the same
-way, leaving out CSVs written before the reasons. --failures keeps every file's columns (an
+way, leaving out CSVs written before the reasons; `pushed` is blank where a run's CSV predates it
+(its pushes are among its grasp_missed). --failures keeps every file's columns (an
 older file's reason columns are empty).
 Standard library only.
 """
@@ -86,6 +87,9 @@ REASONS = ["wrong_object", "pushed", "grasp_missed", "dropped", "goal_in_collisi
            "start_in_collision", "outside_workspace", "invalid_pose", "approach_blocked", "trajectory_refused",
            "collision", "other_failure", "out_of_steps"]
 LATER_REASONS = {"approach_blocked", "pushed"}
+# Later reasons that split an older one (a push was a grasp_missed before): summed only where
+# every run has them, else left blank.
+SPLIT_REASONS = {"pushed"}
 
 
 def reasons(paths):
@@ -104,7 +108,10 @@ def reasons(paths):
                 total["runs"] += 1
                 for column in ["episodes", "success"] + REASONS:
                     total[column] += int(row.get(column) or 0)
-    return [{"task": task, "label": label, "acting_k": k, **{c: t[c] for c in ["runs", "episodes", "success"] + REASONS}}
+                for column in SPLIT_REASONS:
+                    total["without " + column] += not row.get(column)
+    return [{"task": task, "label": label, "acting_k": k, **{c: t[c] for c in ["runs", "episodes", "success"] + REASONS},
+             **{c: "" for c in SPLIT_REASONS if t["without " + c]}}
             for (task, label, k), t in sorted(sums.items(), key=lambda kv: (kv[0][0], kv[0][1], int(kv[0][2] or 0)))]
 
 
@@ -175,8 +182,9 @@ def curves(paths, task):
 
 def processor_of(path):
     """The processor a run's CSV was made on: "model,vector_isa" from machines/NAME beside it
-    (examples/Makefile copies learn.sh's machine file there: started_utc,model,vector_isa,cores a
-    line per start), "mixed" if its starts differ, "" where none was recorded."""
+    (examples/Makefile copies learn.sh's machine file there: started_utc,model,vector_isa,cores, a
+    line more for each other processor it was resumed on), "mixed" if its lines differ, "" where
+    none was recorded."""
     machine = os.path.join(os.path.dirname(path), "machines", os.path.basename(path))
     try:
         with open(machine) as f:

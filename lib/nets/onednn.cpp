@@ -97,8 +97,9 @@ std::unique_ptr<WeightGradient> make_weight_gradient(const memory::desc& x, cons
   return w;
 }
 
-// Created once per shape, layout and way (a network has a handful) and shared by the threads
-// that train.
+// Created once per shape, layout and way (a network has a handful). A primitive keeps its
+// scratch memory (oneDNN's default), so one must not run in two threads at once: the learner's
+// backward runs in the thread that calls it, one at a time.
 const WeightGradient& weight_gradient_for(const memory::desc& x, const memory::desc& dy, int64_t padding) {
   static std::mutex mutex;
   static std::vector<std::unique_ptr<WeightGradient>> cache;

@@ -67,11 +67,19 @@ int main(int argc, char** argv) {
     if (a == "--episodes" && i + 1 < argc) episodes = std::atoi(argv[++i]);
     else if (a == "--approach" && i + 1 < argc) approach = std::atof(argv[++i]);
     else if (a == "--seed" && i + 1 < argc) run_seed = std::strtoull(argv[++i], nullptr, 10);
-    else if (a == "--image-size" && i + 1 < argc && std::sscanf(argv[++i], "%dx%d", &width, &height) == 2) continue;
-    else if (a.rfind("--", 0) == 0) {
+    else if (a == "--image-size" && i + 1 < argc) {
+      if (std::sscanf(argv[++i], "%dx%d", &width, &height) != 2 || width < 8 || height < 8) {
+        std::fprintf(stderr, "bench_grasp_approach: --image-size %s: expected WxH, each at least 8\n", argv[i]);
+        return 2;
+      }
+    } else if (a.rfind("--", 0) == 0) {
       std::fprintf(stderr, "bench_grasp_approach: unknown option %s\n", a.c_str());
       return 2;
     } else tasks.push_back(a);
+  }
+  if (!(approach > 0) || episodes < 1) {
+    std::fprintf(stderr, "bench_grasp_approach: --approach must be above 0 and --episodes at least 1\n");
+    return 2;
   }
   if (tasks.empty())
     tasks = {"pick_and_lift", "take_lid_off_saucepan", "pick_up_cup", "put_rubbish_in_bin", "stack_wine",
@@ -86,6 +94,7 @@ int main(int argc, char** argv) {
               "at grasp");
   for (const std::string& task : tasks) {
     std::map<double, Tally> tallies;
+    int no_grasp = 0;  // scenes whose expert never closes an open gripper
     for (int e = 0; e < episodes; ++e) {
       sim_step::Simulator sim(robot, sim_options);
       stream::Record obs("obs");
@@ -103,7 +112,10 @@ int main(int argc, char** argv) {
         }
         open = w.gripper_open;
       }
-      if (!found) break;  // an expert that never closes an open gripper: not a grasping task
+      if (!found) {
+        ++no_grasp;
+        continue;
+      }
       for (const double m : {0.0, approach}) {
         planning::PlannerOptions options;
         options.approach_m = m;
@@ -134,6 +146,7 @@ int main(int argc, char** argv) {
       std::printf("%-36s %-16s %7d %8d %8d %9d  %s\n", task.c_str(), way, t.scenes, t.refused, t.touched, t.at_grasp,
                   refusals.c_str());
     }
+    if (no_grasp > 0) std::printf("%-36s (%d scenes without a grasp by the expert left out)\n", task.c_str(), no_grasp);
     std::fflush(stdout);
   }
   return 0;

@@ -54,9 +54,10 @@ grep -q "repaired $run/replay.rec: record [0-9]* at byte $replay_bytes: cut off 
 # The final networks acting with another K as well (ALSO_ACT_K; its own K = 1 is failures.csv).
 [ -f "$run/failures.csv" ] && [ -f "$run/failures-act-k2.csv" ] && [ ! -f "$run/failures-act-k1.csv" ] \
   || fail "failure analyses: $(ls "$run")"
-# The processor of each start (the run and its resumption), as results_table.py reads it.
-awk -F, -v cores="$(nproc)" 'NF < 4 || $1 !~ /^20[0-9-]+T[0-9:]+Z$/ || $(NF - 1) !~ /^(avx512f|avx2|sse)$/ || $NF != cores { bad = 1 }
-  END { exit bad || NR != 2 }' "$run/machine" || fail "the run's machine record: $(cat "$run/machine")"
+# The processor the run ran on, as results_table.py reads it: one line, the resumption on the
+# same processor adding none.
+awk -F, -v cores="$(nproc)" 'NF < 4 || $1 !~ /^20[0-9-]+T[0-9:]+Z$/ || $(NF - 1) !~ /^(avx512f|avx2|other)$/ || $NF != cores { bad = 1 }
+  END { exit bad || NR != 1 }' "$run/machine" || fail "the run's machine record: $(cat "$run/machine")"
 final=$(tail -1 "$run/eval.csv")
 column() { awk -F, -v name="$1" 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i } NR == 2 { print $c[name] }' \
   <(head -1 "$run/eval.csv"; echo "$final"); }

@@ -133,6 +133,16 @@ def main():
                  r["out_of_steps"]) for r in summed] == [
             ("reasons_pick_up_cup", "1", "2", "100", str(100 - 40 - 40), "30", "35", "6"),
             ("reasons_pick_up_cup", "10", "1", "50", "10", "9", "30", "0")], summed
+        assert [r["pushed"] for r in summed] == ["", ""], summed  # written before `pushed`: unknown, not 0
+        # A run written with `pushed`: summed where every run of the cell has it, blank where one has not.
+        newer = os.path.join(d, "reasons_stack_wine_qte-k10-t10-seed0.csv")
+        with open(newer, "w") as f:
+            f.write("label,seed,episodes,success,distractor,target,elsewhere,failed_actions,wrong_object,pushed,"
+                    + ",".join(reason_columns[1:]) + "\n")
+            f.write("qte-k10-t10,0,50,30,0,0,0,0,1,7,5,0,1,0,0,0,0,0,0,0,0,6\n")
+        summed = rows_of(run("--reasons", newer, with_reasons[0]).stdout)
+        assert [(r["task"], r["pushed"], r["grasp_missed"]) for r in summed] == [
+            ("reasons_pick_up_cup", "", "20"), ("reasons_stack_wine", "7", "5")], summed
 
         # Summed per task and label: of the tries at an object (success, target, distractor),
         # the share at the right one (success, target).
