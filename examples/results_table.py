@@ -82,7 +82,8 @@ def failures(paths):
 
 
 # failure_reasons.py's reasons, the columns after failed_actions (success has its own column);
-# those added later count 0 in the CSVs written before them.
+# those added later (LATER_REASONS) count 0 in the CSVs written before them, but for those that
+# split an older reason (SPLIT_REASONS), which are left blank.
 REASONS = ["wrong_object", "pushed", "grasp_missed", "dropped", "goal_in_collision", "ik_failed", "no_path",
            "start_in_collision", "outside_workspace", "invalid_pose", "approach_blocked", "trajectory_refused",
            "collision", "other_failure", "out_of_steps"]
