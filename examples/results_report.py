@@ -87,6 +87,10 @@ def section(directory, images):
             out.append("\nTrained by one method, acting with each K: the final networks on the same held-out scenes "
                        "(episodes summed over runs; `acting_k` 1 is greedy without tree expansion):\n")
             out.append(markdown(results_table.acting(failures + others)))
+            out.append("\nThe same cells paired by seed (the interval and test of the paired table): each network "
+                       "acting with tree expansion against itself acting greedily, and, acting alike, each method's "
+                       "networks against C2F-ARM's:\n")
+            out.append(markdown(results_table.acting_paired(failures + others, BASELINE)))
     pictures = [p for p in (f"{name}.png", f"{name}_curves.png", f"{name}_k.png")
                 if os.path.exists(os.path.join(images, p))]
     if pictures:

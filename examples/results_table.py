@@ -8,6 +8,7 @@
     results_table.py --lookalikes FAILURES.csv...
     results_table.py --paired BASELINE [--markdown] RUN.csv...
     results_table.py --acting FAILURES.csv...
+    results_table.py --acting-paired BASELINE [--markdown] FAILURES.csv...
     results_table.py --reasons FAILURES.csv...
 
 One row per task and label (method): the runs' final evaluations (the last eval_point of each run):
@@ -34,6 +35,10 @@ record copied beside the CSVs, name the same model and vector width; under a pro
 budget a faster processor buys more learner steps). --acting sums
 failure_reasons CSVs per task, label (how the networks were trained) and the K they acted with:
 from the name's _act-kK suffix (learn.sh's ALSO_ACT_K), else the label's own (LABEL = ...-kK-...).
+--acting-paired BASELINE compares those cells paired by seed, with --paired's statistics: each
+network acting with its larger K against the same network with its smaller (what acting with
+tree expansion adds), and at each acting K every label's networks against BASELINE's (what
+training with a method adds).
 --reasons sums the episodes' reasons (why each failed: failure_reasons.py's columns) the same
 way, leaving out CSVs written before the reasons; `pushed` is blank where a run's CSV predates it
 (its pushes are among its grasp_missed). --failures keeps every file's columns (an
@@ -137,24 +142,60 @@ def lookalikes(paths):
     return table
 
 
-def acting(paths):
-    """Trained-by x acting-with: failure kinds summed per task, label and acting K."""
-    sums = defaultdict(lambda: defaultdict(int))
+def acting_rows(paths):
+    """(task, label, acting K, row) of each failure_reasons row: the K from the name's _act-kK
+    suffix, else the label's own."""
     for path in paths:
         suffix = re.search(r"_act-k(\d+)\.csv$", path)
         with open(path, newline="") as f:
             for row in csv.DictReader(f):
                 own = label_settings(row["label"])
                 act_k = suffix.group(1) if suffix else str(own[1]) if own else ""
-                name = re.sub(r"_act-k\d+\.csv$", ".csv", path)
-                total = sums[(task_of(name, row), row["label"], act_k)]
-                total["runs"] += 1
-                for kind in ("episodes", "success", "target", "distractor", "elsewhere", "failed_actions"):
-                    total[kind] += int(row.get(kind) or 0)
+                yield task_of(re.sub(r"_act-k\d+\.csv$", ".csv", path), row), row["label"], act_k, row
+
+
+def acting(paths):
+    """Trained-by x acting-with: failure kinds summed per task, label and acting K."""
+    sums = defaultdict(lambda: defaultdict(int))
+    for task, label, act_k, row in acting_rows(paths):
+        total = sums[(task, label, act_k)]
+        total["runs"] += 1
+        for kind in ("episodes", "success", "target", "distractor", "elsewhere", "failed_actions"):
+            total[kind] += int(row.get(kind) or 0)
     return [{"task": task, "label": label, "acting_k": k, **{c: t[c] for c in ("runs", "episodes", "success", "target",
                                                                               "distractor", "elsewhere", "failed_actions")},
              "success_rate": f"{t['success'] / t['episodes']:.3f}" if t["episodes"] else ""}
             for (task, label, k), t in sorted(sums.items(), key=lambda kv: (kv[0][0], kv[0][1], int(kv[0][2] or 0)))]
+
+
+def acting_paired(paths, baseline):
+    """The trained-by x acting-with cells compared paired by seed: per network (label), acting
+    with its larger K against its smaller; per acting K, each label's networks against
+    `baseline`'s."""
+    rate = defaultdict(dict)  # (task, label, acting K) -> seed -> success rate
+    for task, label, act_k, row in acting_rows(paths):
+        rate[(task, label, act_k)][row["seed"]] = int(row["success"]) / int(row["episodes"])
+    table = []
+
+    def compare(task, label, act_k, against, cell, other):
+        seeds = sorted(set(rate[cell]) & set(rate[other]), key=int)
+        if not seeds:
+            return
+        d = [rate[cell][s] - rate[other][s] for s in seeds]
+        table.append({"task": task, "trained_by": label, "acting_k": act_k, "against": against, "pairs": len(d),
+                      "mean_success": f"{statistics.mean(rate[cell][s] for s in seeds):.3f}",
+                      "against_mean_success": f"{statistics.mean(rate[other][s] for s in seeds):.3f}",
+                      **paired_statistics(d), "per_seed": " ".join(f"s{s}:{x:+.2f}" for s, x in zip(seeds, d))})
+
+    for task, label in sorted({(t, l) for t, l, _ in rate}):
+        ks = sorted({k for t, l, k in rate if (t, l) == (task, label)}, key=int)
+        if len(ks) > 1:
+            compare(task, label, ks[-1], f"{label} acting with K = {ks[0]}", (task, label, ks[-1]), (task, label, ks[0]))
+    for task, label, act_k in sorted(rate, key=lambda c: (c[0], int(c[2]), c[1])):
+        if label != baseline and (task, baseline, act_k) in rate:
+            compare(task, label, act_k, f"{baseline} acting with K = {act_k}", (task, label, act_k),
+                    (task, baseline, act_k))
+    return table
 
 
 def evaluations(paths):
@@ -251,6 +292,18 @@ def sign_flip_p(differences):
     return count / 2 ** len(differences)
 
 
+def paired_statistics(differences):
+    """The mean of paired differences, its 95% interval (Student's t; none from one pair) and the
+    exact sign-flip p-value."""
+    mean = statistics.mean(differences)
+    n = len(differences)
+    half = t_quantile(0.975, n - 1) * statistics.stdev(differences) / math.sqrt(n) if n > 1 else None
+    return {"mean_difference": f"{mean:+.3f}",
+            "ci95_low": f"{mean - half:+.3f}" if half is not None else "",
+            "ci95_high": f"{mean + half:+.3f}" if half is not None else "",
+            "sign_flip_p": f"{sign_flip_p(differences):.4f}"}
+
+
 def paired(runs, baseline):
     """Each label against `baseline` on the same task, paired by seed."""
     table = []
@@ -263,8 +316,6 @@ def paired(runs, baseline):
             continue
         d = [float(a["success_rate"]) - float(b["success_rate"]) for a, b in pairs]
         one_processor = sum(a["processor"] not in ("", "mixed") and a["processor"] == b["processor"] for a, b in pairs)
-        mean = statistics.mean(d)
-        half = t_quantile(0.975, len(d) - 1) * statistics.stdev(d) / math.sqrt(len(d)) if len(d) > 1 else float("nan")
         table.append({
             "task": task,
             "label": label,
@@ -272,10 +323,7 @@ def paired(runs, baseline):
             "pairs": len(d),
             "mean_success": f"{statistics.mean(float(a['success_rate']) for a, _ in pairs):.3f}",
             "baseline_mean_success": f"{statistics.mean(float(b['success_rate']) for _, b in pairs):.3f}",
-            "mean_difference": f"{mean:+.3f}",
-            "ci95_low": f"{mean - half:+.3f}" if len(d) > 1 else "",  # no interval from one pair
-            "ci95_high": f"{mean + half:+.3f}" if len(d) > 1 else "",
-            "sign_flip_p": f"{sign_flip_p(d):.4f}",
+            **paired_statistics(d),
             "pairs_one_processor": one_processor,
             "per_seed": " ".join(f"s{a['seed']}:{x:+.2f}" for (a, _), x in zip(pairs, d)),
         })
@@ -311,6 +359,9 @@ def main():
     parser.add_argument("--paired", metavar="BASELINE", help="every other label against BASELINE, paired by seed")
     parser.add_argument("--acting", action="store_true",
                         help="failure_reasons CSVs summed per task, label and the K the networks acted with")
+    parser.add_argument("--acting-paired", metavar="BASELINE",
+                        help="the --acting cells compared paired by seed: each network's larger K against its "
+                             "smaller, and at each K every label against BASELINE")
     parser.add_argument("--reasons", action="store_true",
                         help="failure_reasons CSVs' reasons summed per task, label and acting K")
     parser.add_argument("runs", nargs="+")
@@ -326,6 +377,9 @@ def main():
         return
     if args.acting:
         print_table(acting(args.runs), args.markdown)
+        return
+    if args.acting_paired:
+        print_table(acting_paired(args.runs, args.acting_paired), args.markdown)
         return
     if args.tasks:
         print("\n".join(sorted({task for task, _ in evaluations(args.runs)})))

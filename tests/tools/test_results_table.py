@@ -219,6 +219,26 @@ def main():
         assert [(r["task"], r["label"], r["acting_k"], r["runs"], r["success"], r["success_rate"]) for r in cells] == [
             ("reach_prism", "c2farm-k1-t0", "1", "2", "50", "0.500"), ("reach_prism", "c2farm-k1-t0", "10", "1", "40", "0.800"),
             ("reach_prism", "qte-k10-t10", "1", "1", "25", "0.500")], cells
+        # The cells paired by seed: C2F-ARM's networks acting with K = 10 against themselves
+        # greedy (seed 0 only: seed 1 never acted with 10), and QTE's acting greedily against
+        # C2F-ARM's, by hand: 25/50 - 30/50.
+        compared = rows_of(run("--acting-paired", "c2farm-k1-t0", *crossed).stdout)
+        assert [(r["trained_by"], r["acting_k"], r["against"], r["pairs"], r["mean_difference"], r["ci95_low"],
+                 r["sign_flip_p"]) for r in compared] == [
+            ("c2farm-k1-t0", "10", "c2farm-k1-t0 acting with K = 1", "1", "+0.200", "", "1.0000"),
+            ("qte-k10-t10", "1", "c2farm-k1-t0 acting with K = 1", "1", "-0.100", "", "1.0000")], compared
+        # Three seeds whose K = 10 cells beat K = 1 by 10, 5 and 15 of 50: mean +0.200, sd 0.100,
+        # t(0.975, 2) = 4.303 gives +-0.248; all three positive: 2 of the 8 sign flips are as extreme.
+        three = []
+        for seed, (greedy, expanded) in enumerate([(30, 40), (20, 25), (10, 25)]):
+            for suffix, success in (("", greedy), ("_act-k10", expanded)):
+                path = os.path.join(d, f"three_c2farm-k1-t0-seed{seed}{suffix}.csv")
+                with open(path, "w") as f:
+                    f.write(f"label,seed,episodes,success\nc2farm-k1-t0,{seed},50,{success}\n")
+                three.append(path)
+        row = rows_of(run("--acting-paired", "c2farm-k1-t0", *three).stdout)
+        assert [(r["pairs"], r["mean_difference"], r["ci95_low"], r["ci95_high"], r["sign_flip_p"]) for r in row] == [
+            ("3", "+0.200", "-0.048", "+0.448", "0.2500")], row
 
         empty = os.path.join(d, "empty.csv")
         with open(empty, "w") as f:
