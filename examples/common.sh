@@ -19,6 +19,24 @@ acting_k_of_label() {  # LABEL
   esac
 }
 
+# What a finished learn.sh run RUN (.../<task>/<label>-seed<N>/ with eval.csv and its final
+# eval/checkpoint.rec) was made with, for analyses replayed after it: run_task, run_name,
+# run_label, run_seed, run_k (an array: the K it acts with and qte-select's words for it),
+# run_image (its demonstrations' camera), run_episodes (its evaluations') and
+# run_plan_options (learn.sh's PLAN_OPTIONS). Returns 1 for a run not finished.
+finished_run_settings() {  # RUN
+  local run=${1%/}
+  [ -f "$run/eval.csv" ] && [ -f "$run/eval/checkpoint.rec" ] || return 1
+  run_name=$(basename "$run") run_task=$(basename "$(dirname "$run")")
+  run_label=${run_name%-seed*} run_seed=${run_name##*-seed}
+  read -r -a run_k <<< "$(acting_k_of_label "$run_label")"
+  run_image=$(stream-cat --type obs --head 1 "$run/demos.rec" | stream-dump \
+    | awk '$1 ~ /\.rgb$/ { gsub(/[\[\],]/, ""); print $3 "x" $4; exit }')
+  run_episodes=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) h[i] = $i }
+    NR == 2 { for (i = 1; i <= NF; i++) if (h[i] == "episodes") print $i }' "$run/eval.csv")
+  run_plan_options=$(cat "$run/plan_options" 2>/dev/null || true)
+}
+
 # The learner's numbered checkpoints, DIR/step-NNNNNNNN.rec (qattn-train --checkpoint-dir DIR;
 # the program names them in CheckpointDirectory::path_for, lib/learner/training_files.cpp).
 checkpoint_path() {  # DIR STEP

@@ -23,6 +23,8 @@ BASELINE = "c2farm-k1-t0"
 TITLES = {
     "takeaway1": "Takeaway 1: no loss where tree expansion is not needed (Task Set 1)",
     "takeaway2": "Takeaway 2: a gain under coarse ambiguity (Task Set 2)",
+    "takeaway2-depths3": "Takeaway 2 at 3 depths (0.6 cm voxels; our variation, not published)",
+    "takeaway2-long": "Takeaway 2's `lift_numbered_block` with ten times the experience (2 depths)",
     "takeaway3": "Takeaway 3: ablations on `reach_prism`",
     "takeaway4": "Takeaway 4: the real-world task in simulation (`reach_prism`, 10 minutes of training)",
     "takeaway4-unpaced": "Takeaway 4 without pacing (the earlier protocol, superseded)",
@@ -91,6 +93,13 @@ def section(directory, images):
                        "acting with tree expansion against itself acting greedily, and, acting alike, each method's "
                        "networks against C2F-ARM's:\n")
             out.append(markdown(results_table.acting_paired(failures + others, BASELINE)))
+    decided = sorted(glob.glob(os.path.join(directory, "depths", "*.csv")))
+    if decided:
+        out.append("\nWhich depth decided: where the final agents' chosen voxels lay at each depth, on the "
+                   "held-out scenes (actions summed over runs; `depth0_argmax`: depth 0's own best voxel, where "
+                   "K = 1 goes; `overruled`: the actions whose depth-0 voxel is not depth 0's best, a finer depth "
+                   "having chosen another branch, and `overruled_argmax` where depth 0 alone would have gone):\n")
+        out.append(markdown(results_table.depths(decided)))
     pictures = [p for p in (f"{name}.png", f"{name}_curves.png", f"{name}_k.png")
                 if os.path.exists(os.path.join(images, p))]
     if pictures:

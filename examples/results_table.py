@@ -10,6 +10,7 @@
     results_table.py --acting FAILURES.csv...
     results_table.py --acting-paired BASELINE [--markdown] FAILURES.csv...
     results_table.py --reasons FAILURES.csv...
+    results_table.py --depths DEPTHS.csv...
 
 One row per task and label (method): the runs' final evaluations (the last eval_point of each run):
 the environment and learner steps they had taken (means), their success's mean and sample
@@ -41,7 +42,9 @@ tree expansion adds), and at each acting K every label's networks against BASELI
 training with a method adds).
 --reasons sums the episodes' reasons (why each failed: failure_reasons.py's columns) the same
 way, leaving out CSVs written before the reasons; `pushed` is blank where a run's CSV predates it
-(its pushes are among its grasp_missed). --failures keeps every file's columns (an
+(its pushes are among its grasp_missed). --depths sums depth_decisions.py's
+tables (which depth decided, results/<takeaway>/depths/) per task, label, K and row over runs,
+the shares from the sums. --failures keeps every file's columns (an
 older file's reason columns are empty).
 Standard library only.
 """
@@ -140,6 +143,26 @@ def lookalikes(paths):
                       "tries_at_an_object": tries,
                       "right_share": f"{(t['success'] + t['target']) / tries:.3f}" if tries else ""})
     return table
+
+
+def depths(paths):
+    """depth_decisions.py's tables (results/<takeaway>/depths/TASK_LABEL-seedN.csv) summed per
+    task, label, K and row over runs, with the shares of the sums."""
+    sums = defaultdict(lambda: defaultdict(int))
+    for path in paths:
+        with open(path, newline="") as f:
+            for row in csv.DictReader(f):
+                m = re.fullmatch(rf"(.*)_{re.escape(row['label'])}-seed\d+\.csv", os.path.basename(path))
+                total = sums[(m.group(1) if m else "", row["label"], row["k"], row["row"])]
+                total["runs"] += 1
+                for place in ("actions", "target", "lookalike", "elsewhere"):
+                    total[place] += int(row[place])
+    rows = ["depth0", "depth1", "depth2", "depth0_argmax", "overruled", "overruled_argmax"]
+    order = lambda kv: (kv[0][0], kv[0][1], kv[0][2], rows.index(kv[0][3]) if kv[0][3] in rows else len(rows))
+    return [{"task": task, "label": label, "k": k, "row": name, **t,
+             **{f"{p}_share": f"{t[p] / t['actions']:.3f}" if t["actions"] else "" for p in ("target", "lookalike",
+                                                                                            "elsewhere")}}
+            for (task, label, k, name), t in sorted(sums.items(), key=order)]
 
 
 def acting_rows(paths):
@@ -362,6 +385,8 @@ def main():
     parser.add_argument("--acting-paired", metavar="BASELINE",
                         help="the --acting cells compared paired by seed: each network's larger K against its "
                              "smaller, and at each K every label against BASELINE")
+    parser.add_argument("--depths", action="store_true",
+                        help="depth_decisions.py's tables summed per task, label, K and row")
     parser.add_argument("--reasons", action="store_true",
                         help="failure_reasons CSVs' reasons summed per task, label and acting K")
     parser.add_argument("runs", nargs="+")
@@ -377,6 +402,9 @@ def main():
         return
     if args.acting:
         print_table(acting(args.runs), args.markdown)
+        return
+    if args.depths:
+        print_table(depths(args.runs), args.markdown)
         return
     if args.acting_paired:
         print_table(acting_paired(args.runs, args.acting_paired), args.markdown)

@@ -91,6 +91,26 @@ if problems:
 EOF
 done
 
+# --- depths_of_runs.sh: a finished run's settings decide the replay ----------------------------
+# A run of label qte-k3-t3 whose demonstrations had a 32x32 camera and whose evaluations had 2
+# episodes: its table is depth_decisions.sh's with K = 3, 32x32 and 2 episodes; a run not
+# finished (no final checkpoint) gets none, and a table already there is kept.
+run=$tmp/runs/reach_prism/qte-k3-t3-seed4
+mkdir -p "$run/eval" "$tmp/runs/reach_prism/qte-k3-t3-seed5"
+cp "$src/tests/data/reach_target_demo.rec" "$run/demos.rec"
+cp "$tmp/ckpt/latest.rec" "$run/eval/checkpoint.rec"
+printf 'label,seed,env_steps,episodes,successes\nqte-k3-t3,4,0,2,0\n' > "$run/eval.csv"
+timeout 300 bash "$src/examples/depth_decisions.sh" reach_prism "$tmp/ckpt/latest.rec" 3 32x32 2 qte-k3-t3 \
+  > "$tmp/direct.csv" 2>/dev/null || fail "depth_decisions.sh for the run's settings"
+timeout 300 bash "$src/examples/depths_of_runs.sh" "$tmp/runs" "$tmp/depths" 2> "$tmp/runs.err" \
+  || fail "depths_of_runs.sh exit $?: $(cat "$tmp/runs.err")"
+[ "$(ls "$tmp/depths")" = reach_prism_qte-k3-t3-seed4.csv ] || fail "depths_of_runs.sh wrote $(ls "$tmp/depths")"
+cmp -s "$tmp/direct.csv" "$tmp/depths/reach_prism_qte-k3-t3-seed4.csv" \
+  || fail "depths_of_runs.sh's table is not the run's: $(cat "$tmp/depths/reach_prism_qte-k3-t3-seed4.csv")"
+echo kept > "$tmp/depths/reach_prism_qte-k3-t3-seed4.csv"
+bash "$src/examples/depths_of_runs.sh" "$tmp/runs" "$tmp/depths" 2>/dev/null \
+  && [ "$(cat "$tmp/depths/reach_prism_qte-k3-t3-seed4.csv")" = kept ] || fail "a table already there was not kept"
+
 # --- a stream without objects is refused, naming the option -----------------------------------
 err=$($py "$src/examples/depth_decisions.py" "$src/tests/data/pick_and_lift_obs.rec" 2>&1); rc=$?
 [ $rc != 0 ] && grep -q "sim-step --objects" <<<"$err" || fail "a stream without objects: exit $rc: $err"

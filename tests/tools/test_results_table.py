@@ -240,6 +240,22 @@ def main():
         assert [(r["pairs"], r["mean_difference"], r["ci95_low"], r["ci95_high"], r["sign_flip_p"]) for r in row] == [
             ("3", "+0.200", "-0.048", "+0.448", "0.2500")], row
 
+        # Which depth decided, summed over two runs of one label; the shares are those of the sums
+        # (3 of 5 + 1 of 3 on the target at depth 1: 4 of 8), not the mean of the runs' shares.
+        decided = []
+        for seed, (depth0, depth1) in enumerate([((5, 2, 2, 1), (5, 3, 1, 1)), ((3, 1, 2, 0), (3, 1, 1, 1))]):
+            path = os.path.join(d, f"lift_numbered_block_qte-k10-t10-seed{seed}.csv")
+            with open(path, "w") as f:
+                f.write("label,k,row,actions,target,lookalike,elsewhere,target_share,lookalike_share,elsewhere_share\n")
+                for name, counts in (("depth1", depth1), ("depth0", depth0)):
+                    f.write(f"qte-k10-t10,10,{name},{','.join(map(str, counts))},x,x,x\n")
+            decided.append(path)
+        table = rows_of(run("--depths", *decided).stdout)
+        assert [(r["task"], r["row"], r["runs"], r["actions"], r["target"], r["lookalike"], r["elsewhere"],
+                 r["target_share"]) for r in table] == [
+            ("lift_numbered_block", "depth0", "2", "8", "3", "4", "1", "0.375"),
+            ("lift_numbered_block", "depth1", "2", "8", "4", "2", "2", "0.500")], table
+
         empty = os.path.join(d, "empty.csv")
         with open(empty, "w") as f:
             f.write(",".join(COLUMNS) + "\n")
