@@ -23,7 +23,8 @@ acting_k_of_label() {  # LABEL
 # eval/checkpoint.rec) was made with, for analyses replayed after it: run_task, run_name,
 # run_label, run_seed, run_k (an array: the K it acts with and qte-select's words for it),
 # run_image (its demonstrations' camera), run_episodes (its evaluations') and
-# run_plan_options (learn.sh's PLAN_OPTIONS). Returns 1 for a run not finished.
+# run_plan_options (learn.sh's PLAN_OPTIONS). Returns 1 for a run not finished; exits the
+# script for a finished run whose settings cannot be read.
 finished_run_settings() {  # RUN
   local run=${1%/}
   [ -f "$run/eval.csv" ] && [ -f "$run/eval/checkpoint.rec" ] || return 1
@@ -35,6 +36,10 @@ finished_run_settings() {  # RUN
   run_episodes=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) h[i] = $i }
     NR == 2 { for (i = 1; i <= NF; i++) if (h[i] == "episodes") print $i }' "$run/eval.csv")
   run_plan_options=$(cat "$run/plan_options" 2>/dev/null || true)
+  if [ -z "$run_image" ] || [ -z "$run_episodes" ]; then  # a finished run lacks neither: stop, do not guess
+    echo "$run: no camera size in demos.rec or no episodes column in eval.csv" >&2
+    exit 1
+  fi
 }
 
 # The learner's numbered checkpoints, DIR/step-NNNNNNNN.rec (qattn-train --checkpoint-dir DIR;

@@ -15,6 +15,11 @@ for run in "$1"/takeaway*/*/*-seed*/; do
   [ -f "$run/failures.csv" ] || [ -f "$out" ] && continue
   echo "$takeaway $run_task $run_name: K ${run_k[*]}, $run_image, $run_episodes episodes" >&2
   mkdir -p "$(dirname "$out")"
-  PLAN_OPTIONS=$run_plan_options bash "$here/failure_reasons.sh" "$run_task" "$run/eval/checkpoint.rec" "${run_k[0]}" \
-    "$run_image" "$run_episodes" "$run_label" "$run_seed" "${run_k[@]:1}" > "$out.tmp" && mv "$out.tmp" "$out"
+  if ! PLAN_OPTIONS=$run_plan_options bash "$here/failure_reasons.sh" "$run_task" "$run/eval/checkpoint.rec" \
+      "${run_k[0]}" "$run_image" "$run_episodes" "$run_label" "$run_seed" "${run_k[@]:1}" > "$out.tmp"; then
+    rm -f "$out.tmp"
+    echo "failures_of_runs.sh: failure_reasons.sh failed for $run" >&2
+    exit 1
+  fi
+  mv "$out.tmp" "$out"
 done

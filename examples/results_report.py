@@ -89,10 +89,12 @@ def section(directory, images):
             out.append("\nTrained by one method, acting with each K: the final networks on the same held-out scenes "
                        "(episodes summed over runs; `acting_k` 1 is greedy without tree expansion):\n")
             out.append(markdown(results_table.acting(failures + others)))
-            out.append("\nThe same cells paired by seed (the interval and test of the paired table): each network "
-                       "acting with tree expansion against itself acting greedily, and, acting alike, each method's "
-                       "networks against C2F-ARM's:\n")
-            out.append(markdown(results_table.acting_paired(failures + others, BASELINE)))
+            compared = results_table.acting_paired(failures + others, BASELINE)
+            if compared:
+                out.append("\nThe same cells paired by seed (the interval and test of the paired table): each network "
+                           "that also acted with another K, acting with the larger K against itself acting with the "
+                           "smaller, and, acting alike, each method's networks against C2F-ARM's:\n")
+                out.append(markdown(compared))
     decided = sorted(glob.glob(os.path.join(directory, "depths", "*.csv")))
     if decided:
         out.append("\nWhich depth decided: where the final agents' chosen voxels lay at each depth, on the "

@@ -197,7 +197,8 @@ def acting_paired(paths, baseline):
     `baseline`'s."""
     rate = defaultdict(dict)  # (task, label, acting K) -> seed -> success rate
     for task, label, act_k, row in acting_rows(paths):
-        rate[(task, label, act_k)][row["seed"]] = int(row["success"]) / int(row["episodes"])
+        if act_k:  # an adaptive K's label names no K to pair by
+            rate[(task, label, act_k)][row["seed"]] = int(row["success"]) / int(row["episodes"])
     table = []
 
     def compare(task, label, act_k, against, cell, other):

@@ -100,8 +100,10 @@ mkdir -p "$run/eval" "$tmp/runs/reach_prism/qte-k3-t3-seed5"
 cp "$src/tests/data/reach_target_demo.rec" "$run/demos.rec"
 cp "$tmp/ckpt/latest.rec" "$run/eval/checkpoint.rec"
 printf 'label,seed,env_steps,episodes,successes\nqte-k3-t3,4,0,2,0\n' > "$run/eval.csv"
-timeout 300 bash "$src/examples/depth_decisions.sh" reach_prism "$tmp/ckpt/latest.rec" 3 32x32 2 qte-k3-t3 \
-  > "$tmp/direct.csv" 2>/dev/null || fail "depth_decisions.sh for the run's settings"
+echo "--approach 0.1" > "$run/plan_options"  # learn.sh's PLAN_OPTIONS, replayed as the run planned
+PLAN_OPTIONS="--approach 0.1" AGENT="$tmp/direct.rec" timeout 300 bash "$src/examples/depth_decisions.sh" reach_prism \
+  "$tmp/ckpt/latest.rec" 3 32x32 2 qte-k3-t3 > "$tmp/direct.csv" 2>/dev/null || fail "depth_decisions.sh for the run's settings"
+[ "$(stream-cat --type trajectory "$tmp/direct.rec" | wc -c)" -gt 0 ] || fail "the direct replay planned nothing"
 timeout 300 bash "$src/examples/depths_of_runs.sh" "$tmp/runs" "$tmp/depths" 2> "$tmp/runs.err" \
   || fail "depths_of_runs.sh exit $?: $(cat "$tmp/runs.err")"
 [ "$(ls "$tmp/depths")" = reach_prism_qte-k3-t3-seed4.csv ] || fail "depths_of_runs.sh wrote $(ls "$tmp/depths")"
@@ -110,6 +112,13 @@ cmp -s "$tmp/direct.csv" "$tmp/depths/reach_prism_qte-k3-t3-seed4.csv" \
 echo kept > "$tmp/depths/reach_prism_qte-k3-t3-seed4.csv"
 bash "$src/examples/depths_of_runs.sh" "$tmp/runs" "$tmp/depths" 2>/dev/null \
   && [ "$(cat "$tmp/depths/reach_prism_qte-k3-t3-seed4.csv")" = kept ] || fail "a table already there was not kept"
+# The run's planner options reach plan-path: one it refuses stops the script, naming the run,
+# and leaves no table, whole or half-written.
+cp -r "$run" "$tmp/runs/reach_prism/qte-k3-t3-seed6"
+echo "--no-such-option" > "$tmp/runs/reach_prism/qte-k3-t3-seed6/plan_options"
+err=$(timeout 300 bash "$src/examples/depths_of_runs.sh" "$tmp/runs" "$tmp/depths" 2>&1) && fail "a refused planner option passed"
+grep -q "failed for .*qte-k3-t3-seed6" <<<"$err" || fail "the failed run is not named: $err"
+[ "$(ls "$tmp/depths")" = reach_prism_qte-k3-t3-seed4.csv ] || fail "a failed run left $(ls "$tmp/depths")"
 
 # --- a stream without objects is refused, naming the option -----------------------------------
 err=$($py "$src/examples/depth_decisions.py" "$src/tests/data/pick_and_lift_obs.rec" 2>&1); rc=$?
