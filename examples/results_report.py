@@ -23,7 +23,9 @@ BASELINE = "c2farm-k1-t0"
 TITLES = {
     "takeaway1": "Takeaway 1: no loss where tree expansion is not needed (Task Set 1)",
     "takeaway2": "Takeaway 2: a gain under coarse ambiguity (Task Set 2)",
-    "takeaway2-depths3": "Takeaway 2 at 3 depths (0.6 cm voxels; our variation, not published)",
+    "takeaway2-depths3": "Takeaway 2 at 3 depths (0.6 cm voxels, 1,000 pretraining steps; our variation, not published)",
+    "takeaway2-depths3-pretrain100":
+        "Takeaway 2 at 3 depths with takeaway 2's 100 pretraining steps (superseded: the finest depth breaks)",
     "takeaway2-long": "Takeaway 2's `lift_numbered_block` with ten times the experience (2 depths)",
     "takeaway3": "Takeaway 3: ablations on `reach_prism`",
     "takeaway4": "Takeaway 4: the real-world task in simulation (`reach_prism`, 10 minutes of training)",
