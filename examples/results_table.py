@@ -432,7 +432,10 @@ def main():
             rows.sort(key=lambda r: (int(r["k"]), int(r["seed"])))
             if not rows:
                 return
-        writer = csv.DictWriter(sys.stdout, fieldnames=list(rows[0].keys()), lineterminator="\n")
+        # Runs of different ages have different columns (older CSVs lack the processor split):
+        # every column any run has, blank where a run lacks it.
+        columns = list(dict.fromkeys(c for row in rows for c in row))
+        writer = csv.DictWriter(sys.stdout, fieldnames=columns, restval="", lineterminator="\n")
         writer.writeheader()
         writer.writerows(rows)
         return

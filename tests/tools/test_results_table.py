@@ -69,6 +69,16 @@ def main():
             ("lift_numbered_block qte-k10-t10", "0", "19"), ("pick_and_lift_small qte-k10-t10", "0", "40"),
             ("reach_prism qte-k2-t2", "0", "36")], finals
 
+        # A newer run's CSV splits cpu_s by role; an older one's does not: every run is in the
+        # finals, the older one's split blank.
+        newer = os.path.join(d, "lift_numbered_block_qte-k10-t10-seed1.csv")
+        with open(newer, "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(COLUMNS[:7] + ["cpu_learner_s"] + COLUMNS[7:])
+            w.writerow(["qte-k10-t10", 1, 400, 140, 400, 60, 100, 80.5, 50, 25, 0.5, 0.3, 0.7, 4, 25])
+        mixed = rows_of(run("--finals", paths[2], newer).stdout)
+        assert [(r["seed"], r["successes"], r["cpu_learner_s"]) for r in mixed] == [("0", "19", ""), ("1", "25", "80.5")], mixed
+
         ablation = rows_of(run("--k-ablation", *paths).stdout)
         assert [(r["k"], r["label"]) for r in ablation] == [("2", "qte-k2-t2"), ("10", "qte-k10-t10"),
                                                             ("10", "qte-k10-t10")], ablation
