@@ -67,10 +67,9 @@ def label_settings(label):
 
 
 def task_of(path, row):
-    """TASK of TASK_LABEL-seedN.csv (examples/Makefile's results), else ''."""
-    suffix = f"_{row['label']}-seed{row['seed']}.csv"
-    name = os.path.basename(path)
-    return name[:-len(suffix)] if name.endswith(suffix) else ""
+    """TASK of TASK_LABEL-seedN.csv (examples/Makefile's results, LABEL the row's), else ''."""
+    m = re.fullmatch(rf"(.*)_{re.escape(row['label'])}-seed\d+\.csv", os.path.basename(path))
+    return m.group(1) if m else ""
 
 
 def failures(paths):
@@ -152,8 +151,7 @@ def depths(paths):
     for path in paths:
         with open(path, newline="") as f:
             for row in csv.DictReader(f):
-                m = re.fullmatch(rf"(.*)_{re.escape(row['label'])}-seed\d+\.csv", os.path.basename(path))
-                total = sums[(m.group(1) if m else "", row["label"], row["k"], row["row"])]
+                total = sums[(task_of(path, row), row["label"], row["k"], row["row"])]
                 total["runs"] += 1
                 for place in ("actions", "target", "lookalike", "elsewhere"):
                     total[place] += int(row[place])
@@ -357,14 +355,16 @@ def paired(runs, baseline):
 def print_table(table, markdown):
     if not table:
         return
-    columns = list(table[0].keys())
+    # Rows from runs of different ages can have different columns (older CSVs lack the
+    # processor split): every column any row has, blank where a row lacks it.
+    columns = list(dict.fromkeys(c for row in table for c in row))
     if markdown:
         print("| " + " | ".join(columns) + " |")
         print("|" + "---|" * len(columns))
         for row in table:
-            print("| " + " | ".join(str(row[c]) for c in columns) + " |")
+            print("| " + " | ".join(str(row.get(c, "")) for c in columns) + " |")
     else:
-        writer = csv.DictWriter(sys.stdout, fieldnames=columns, lineterminator="\n")
+        writer = csv.DictWriter(sys.stdout, fieldnames=columns, restval="", lineterminator="\n")
         writer.writeheader()
         writer.writerows(table)
 
@@ -432,12 +432,7 @@ def main():
             rows.sort(key=lambda r: (int(r["k"]), int(r["seed"])))
             if not rows:
                 return
-        # Runs of different ages have different columns (older CSVs lack the processor split):
-        # every column any run has, blank where a run lacks it.
-        columns = list(dict.fromkeys(c for row in rows for c in row))
-        writer = csv.DictWriter(sys.stdout, fieldnames=columns, restval="", lineterminator="\n")
-        writer.writeheader()
-        writer.writerows(rows)
+        print_table(rows, markdown=False)
         return
     if args.paired:
         print_table(paired(runs, args.paired), args.markdown)
