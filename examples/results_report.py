@@ -75,7 +75,8 @@ def section(directory, images):
         if paired:
             out.append(f"\nEach method against C2F-ARM (`{BASELINE}`), paired by seed: mean difference in final "
                        "success rate, its 95% interval (Student's t over the paired differences) and the two-sided "
-                       "p-value of the exact sign-flip permutation test:\n")
+                       "p-value of the exact sign-flip permutation test; a method compared on several tasks also with "
+                       "all its pairs pooled (`all N tasks`):\n")
             out.append(markdown(paired))
         cpu = cpu_by_role(runs)
         if cpu:

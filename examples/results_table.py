@@ -33,7 +33,9 @@ and the two-sided p-value of the exact sign-flip permutation test (all 2^n sign 
 the n differences; the test makes no assumption about their distribution), and how many of the
 pairs were made on one processor (pairs_one_processor: both runs' machines/ files, learn.sh's
 record copied beside the CSVs, name the same model and vector width; under a processor-time
-budget a faster processor buys more learner steps). --acting sums
+budget a faster processor buys more learner steps). A label compared on several tasks gets a
+further row, "all N tasks", of all its (task, seed) pairs pooled: the question of a suite ("no
+loss across Task Set 1") rather than of one task. --acting sums
 failure_reasons CSVs per task, label (how the networks were trained) and the K they acted with:
 from the name's _act-kK suffix (learn.sh's ALSO_ACT_K), else the label's own (LABEL = ...-kK-...).
 --acting-paired BASELINE compares those cells paired by seed, with --paired's statistics: each
@@ -49,6 +51,7 @@ older file's reason columns are empty).
 Standard library only.
 """
 import argparse
+import collections
 import csv
 import itertools
 import math
@@ -306,12 +309,27 @@ def t_quantile(p, df):
 
 
 def sign_flip_p(differences):
-    """Two-sided p-value of the exact sign-flip permutation test of a zero mean difference."""
-    observed = abs(sum(differences))
-    count = 0
-    for signs in itertools.product((1, -1), repeat=len(differences)):
-        count += abs(sum(s * d for s, d in zip(signs, differences))) >= observed - 1e-12
-    return count / 2 ** len(differences)
+    """Two-sided p-value of the exact sign-flip permutation test of a zero mean difference: the
+    share of the 2^n sign assignments whose |sum| reaches the observed one. Success rates are
+    counts over 20 or 50 episodes, so the differences lie on a grid of 1/1000, where the sums of
+    all assignments are counted by convolution for any number of pairs; off that grid they are
+    enumerated."""
+    grid = [round(d * 1000) for d in differences]
+    if any(abs(g - d * 1000) > 1e-6 for g, d in zip(grid, differences)):
+        observed = abs(sum(differences))
+        count = 0
+        for signs in itertools.product((1, -1), repeat=len(differences)):
+            count += abs(sum(s * d for s, d in zip(signs, differences))) >= observed - 1e-12
+        return count / 2 ** len(differences)
+    sums = {0: 1}  # sum of the signed differences -> number of sign assignments giving it
+    for g in grid:
+        following = collections.Counter()
+        for total, count in sums.items():
+            following[total + g] += count
+            following[total - g] += count
+        sums = following
+    observed = abs(sum(grid))
+    return sum(count for total, count in sums.items() if abs(total) >= observed) / 2 ** len(grid)
 
 
 def paired_statistics(differences):
@@ -348,7 +366,30 @@ def paired(runs, baseline):
             **paired_statistics(d),
             "pairs_one_processor": one_processor,
             "per_seed": " ".join(f"s{a['seed']}:{x:+.2f}" for (a, _), x in zip(pairs, d)),
+            "rates": [(float(a["success_rate"]), float(b["success_rate"])) for a, b in pairs],
         })
+    # A label compared on several tasks: all its (task, seed) pairs pooled, the question of a
+    # suite ("no loss across Task Set 1") rather than of one task.
+    for label in sorted({row["label"] for row in table}):
+        rows = [row for row in table if row["label"] == label]
+        if len(rows) < 2:
+            continue
+        rates = [pair for row in rows for pair in row["rates"]]
+        d = [a - b for a, b in rates]
+        table.append({
+            "task": f"all {len(rows)} tasks",
+            "label": label,
+            "baseline": baseline,
+            "pairs": len(d),
+            "mean_success": f"{statistics.mean(a for a, _ in rates):.3f}",
+            "baseline_mean_success": f"{statistics.mean(b for _, b in rates):.3f}",
+            **paired_statistics(d),
+            "pairs_one_processor": sum(row["pairs_one_processor"] for row in rows),
+            "per_seed": "",
+            "rates": rates,
+        })
+    for row in table:
+        del row["rates"]
     return table
 
 

@@ -198,6 +198,39 @@ def main():
         assert pair[0]["per_seed"] == "s0:+0.08 s1:+0.04 s2:+0.12 s3:-0.04 s4:+0.10", pair
         assert pair[0]["pairs_one_processor"] == "0", pair  # no machines/ files: none known
 
+        # A label compared on several tasks gets a row of all its (task, seed) pairs pooled; its
+        # p-value (counted on the 1/1000 grid of success rates) is checked against enumerating
+        # all 2^14 sign assignments here: reach_prism's 5 pairs above and 9 of take_lid_off_saucepan.
+        pooled_dir = os.path.join(d, "pooled")
+        os.makedirs(pooled_dir)
+        reach = [(20, 24), (30, 32), (10, 16), (40, 38), (25, 30)]  # reach_prism's pairs above
+        lid = [(31, 33), (40, 40), (12, 19), (45, 44), (28, 35), (33, 30), (20, 27), (49, 50), (38, 41)]
+        more = []
+        for task, task_pairs in [("reach_prism", reach), ("take_lid_off_saucepan", lid)]:
+            for seed, (base, qte) in enumerate(task_pairs):
+                more.append(write_run(pooled_dir, f"{task}_c2farm-k1-t0-seed{seed}.csv", "c2farm-k1-t0", seed,
+                                      [(base, 9)]))
+                more.append(write_run(pooled_dir, f"{task}_qte-k10-t10-seed{seed}.csv", "qte-k10-t10", seed,
+                                      [(qte, 9)]))
+        pooled = rows_of(run("--paired", "c2farm-k1-t0", *more).stdout)
+        assert [(r["task"], r["pairs"]) for r in pooled] == [
+            ("reach_prism", "5"), ("take_lid_off_saucepan", "9"), ("all 2 tasks", "14")], pooled
+        all_d = [(qte - base) / 50 for base, qte in reach + lid]
+        sums = [abs(sum(s * x for s, x in zip(signs, all_d)))
+                for signs in __import__("itertools").product((1, -1), repeat=14)]
+        brute = sum(v >= abs(sum(all_d)) - 1e-9 for v in sums) / 2 ** 14
+        mean = statistics.mean(all_d)
+        assert pooled[2]["mean_difference"] == f"{mean:+.3f}", pooled[2]
+        assert pooled[2]["sign_flip_p"] == f"{brute:.4f}", (pooled[2], brute)
+        assert pooled[2]["mean_success"] == f"{statistics.mean(q for _, q in reach + lid) / 50:.3f}"
+        # Rates off that grid (3 episodes: thirds) are enumerated: the same p either way.
+        sys.path.insert(0, os.path.dirname(SCRIPT))
+        import results_table
+        thirds = [1 / 3, -2 / 3, 1.0, 2 / 3, 1 / 3]
+        sums = [abs(sum(s * x for s, x in zip(signs, thirds)))
+                for signs in __import__("itertools").product((1, -1), repeat=5)]
+        assert results_table.sign_flip_p(thirds) == sum(v >= abs(sum(thirds)) - 1e-9 for v in sums) / 32
+
         # Pairs made on one processor, from learn.sh's machine files in machines/: seeds 0 and 1
         # both runs on one (seed 1's QTE run resumed on it), seed 2 on two kinds, seed 3's C2F-ARM
         # run resumed on another kind (mixed), seed 4 only QTE's recorded.
