@@ -28,7 +28,7 @@ TITLES = {
         "Takeaway 2 at 3 depths with takeaway 2's 100 pretraining steps (superseded: the finest depth breaks)",
     "takeaway2-long": "Takeaway 2's `lift_numbered_block` with ten times the experience (2 depths)",
     "takeaway3": "Takeaway 3: ablations on `reach_prism`",
-    "takeaway4": "Takeaway 4: the real-world task in simulation (`reach_prism`, 10 minutes of training)",
+    "takeaway4": "Takeaway 4: the real-world task in simulation (`reach_prism`, 1,200 processor seconds)",
     "takeaway4-unpaced": "Takeaway 4 without pacing (the earlier protocol, superseded)",
     "takeaway1-pick_up_cup-planned-to-grasp":
         "Takeaway 1's `pick_up_cup` with grasps planned to the grasp itself (superseded: the path swept through the cup)",
