@@ -4,13 +4,17 @@
 # the target missed, elsewhere; and a reason per episode (wrong object, grasp missed, dropped,
 # the planner's or the simulator's refusal, out of steps), counted per reason.
 # Usage: failure_reasons.sh TASK CHECKPOINT K [IMAGE] [EPISODES] [LABEL] [SEED] [QTE-SELECT OPTIONS...]
-#        (the built programs on PATH). The scenes are learn.sh's evaluation scenes: VARIATION
+#        (the built programs on PATH). CHECKPOINT `keyframes`: no networks, the expert's own
+#        keyframes on these scenes as keyframe(1) discretizes them for the learner (NET_OPTIONS:
+#        its --depths and --offset), acted with qte-select --keyframes: the ceiling of learning
+#        on this grid, planner and task. The scenes are learn.sh's evaluation scenes: VARIATION
 #        (0), EVAL_SEED (1000000) and PLAN_OPTIONS as there. FAILURE_EPISODES=1: a line per episode on stderr.
 # The expert's episodes of the scenes are recorded once per task, VARIATION, EVAL_SEED,
 # EPISODES, IMAGE and demo-record program (its checksum: a rebuilt expert records again) and
 # kept in EXPERT_CACHE, by default expert-cache/ beside the run directory (the checkpoint's
 # directory's parent: RUNS/<takeaway>/<task>/expert-cache for learn.sh's runs, shared by
-# every method and seed of the task); EXPERT_CACHE= (empty) keeps nothing.
+# every method and seed of the task; with CHECKPOINT `keyframes` nothing unless EXPERT_CACHE is
+# set); EXPERT_CACHE= (empty) keeps nothing.
 set -euo pipefail
 task=$1 checkpoint=$2 k=$3 image=${4:-256x256} episodes=${5:-50} label=${6:-k$3} seed=${7:-}
 shift $(( $# < 7 ? $# : 7 ))
@@ -19,7 +23,8 @@ source "$here/common.sh"
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 scenes=(--task "$task" --variation "${VARIATION:-0}" --episodes "$episodes" --seed "${EVAL_SEED:-1000000}" --scenes eval
         --image-size "$image")
-cache=${EXPERT_CACHE-$(dirname "$(dirname "$checkpoint")")/../expert-cache}
+if [ "$checkpoint" = keyframes ]; then cache=${EXPERT_CACHE-}; else
+  cache=${EXPERT_CACHE-$(dirname "$(dirname "$checkpoint")")/../expert-cache}; fi
 if [ -n "$cache" ]; then
   build=$(sha256sum "$(command -v demo-record)" | cut -c1-12)
   experts=$cache/${task}_variation${VARIATION:-0}_seed${EVAL_SEED:-1000000}_episodes${episodes}_${image}_demo-record-$build.rec
@@ -30,9 +35,15 @@ if [ ! -f "$experts" ]; then  # demo-record writes its --output whole or not at 
   mkdir -p "$(dirname "$experts")"
   demo-record "${scenes[@]}" --objects --no-points --compress --output "$experts" 2>/dev/null
 fi
+if [ "$checkpoint" = keyframes ]; then
+  keyframe ${NET_OPTIONS:-} --output "$tmp/keyframes.rec" "$experts" 2>/dev/null
+  agent=(--keyframes "$tmp/keyframes.rec")
+else
+  agent=(--checkpoint "$checkpoint" --k "$k" --threads 1)
+fi
 agent_loop "$tmp/loop" \
   sim-step "${scenes[@]}" --objects \
-  qte-select --checkpoint "$checkpoint" --k "$k" "$@" --threads 1 \
+  qte-select "${agent[@]}" "$@" \
   plan-path ${PLAN_OPTIONS:-} > "$tmp/agent.rec"
 "$PYTHON" "$here/failure_reasons.py" --label "$label" --seed "$seed" ${FAILURE_EPISODES:+--episodes} \
   "$experts" "$tmp/agent.rec"

@@ -6,7 +6,8 @@
 One section per takeaway directory of RESULTS_DIR (examples/results/): the final success per
 method (results_table.py's table), every method against C2F-ARM paired by seed (mean
 difference, 95% interval, exact sign-flip p-value), the processor time by role where the runs
-recorded it, where the final agents went (failure_reasons), the pictures that paper-report
+recorded it, where the final agents went (failure_reasons) and the ceiling of learning on their
+tasks (ceiling.sh, results/ceiling/), the pictures that paper-report
 draws, and the directory's reading.md (the paper's claim and our reading, written by hand).
 Every number in the document comes from a CSV; a test checks the document is up to date.
 Standard library only.
@@ -60,6 +61,17 @@ def cpu_by_role(runs):
     return table
 
 
+def ceiling_of(directory, tasks):
+    """ceiling.sh's CSVs (results/ceiling/TASK_LABEL.csv) of `tasks` at the section's grid: the
+    3-depth ones for a 3-depth takeaway, else the published 2 depths'; none for runs planned
+    without the straight approach their task now uses."""
+    if "planned-to-grasp" in directory:
+        return []
+    label = "keyframes-depths3" if "depths3" in os.path.basename(directory.rstrip("/")) else "keyframes"
+    paths = [os.path.join(directory, "..", "ceiling", f"{task}_{label}.csv") for task in sorted(tasks)]
+    return [p for p in paths if os.path.exists(p)]
+
+
 def section(directory, images):
     name = os.path.basename(directory.rstrip("/"))
     csvs = sorted(glob.glob(os.path.join(directory, "*-seed*.csv")))
@@ -87,6 +99,12 @@ def section(directory, images):
             out.append("\nWhere the final agents went on the held-out scenes (episodes summed over runs; "
                        "`right_share`: of the tries at an object, the share at the right one):\n")
             out.append(markdown(results_table.lookalikes(failures)))
+        ceiling = ceiling_of(directory, {task for task, _ in runs})
+        if ceiling:
+            out.append("\nThe ceiling of learning (`make -C examples ceiling`): the expert's own keyframes on the same "
+                       "held-out scenes, discretized as the networks' targets (the voxel per depth, 5-degree rotation "
+                       "bins, the gripper) and acted through the same planner, what no network on this grid can beat:\n")
+            out.append(markdown(results_table.reasons(ceiling)))
         others = sorted(glob.glob(os.path.join(directory, "acting", "*.csv")))
         if others:
             out.append("\nTrained by one method, acting with each K: the final networks on the same held-out scenes "

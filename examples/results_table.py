@@ -70,8 +70,9 @@ def label_settings(label):
 
 
 def task_of(path, row):
-    """TASK of TASK_LABEL-seedN.csv (examples/Makefile's results, LABEL the row's), else ''."""
-    m = re.fullmatch(rf"(.*)_{re.escape(row['label'])}-seed\d+\.csv", os.path.basename(path))
+    """TASK of TASK_LABEL-seedN.csv (examples/Makefile's results, LABEL the row's) or of
+    TASK_LABEL.csv (an analysis without a seed, as ceiling.sh's), else ''."""
+    m = re.fullmatch(rf"(.*)_{re.escape(row['label'])}(-seed\d+)?\.csv", os.path.basename(path))
     return m.group(1) if m else ""
 
 

@@ -8,6 +8,7 @@
 #include "nets/qattention_net.hpp"
 #include "point_clouds/cloud_filters.hpp"
 #include "qattention/branching_options.hpp"
+#include "qattention/keyframe_stage.hpp"
 #include "qattention/select_stage.hpp"
 #include "stream/reader.hpp"
 #include "stream/stage.hpp"
@@ -58,10 +59,20 @@ static cli::Usage usage() {
       "DIR/<n>.depth<d>.png (n the action's index, from 000000): the occupied voxels coloured "
       "by Q (blue low, red high) and the chosen voxel outlined in red. It costs one more forward "
       "per depth.",
+      "With --keyframes FILE instead of --checkpoint there are no networks: the agent acts with "
+      "the demonstrated keyframes of FILE (keyframe's output), each as keyframe discretized it "
+      "for the learner: the voxel per depth, the rotation bins and the gripper command the "
+      "networks are trained to choose. The n-th episode of the input takes FILE's n-th "
+      "demonstration and its step s that demonstration's keyframe s (the last again after its "
+      "end). Run on the demonstrations' own scenes (demo-record and sim-step with the same "
+      "--task, --scenes, --seed and --image-size), it measures the best any network could "
+      "reach on this grid, planner and task: the ceiling of learning. The action's Q-values "
+      "and value are 0 and its checkpoint_step is -1.",
   };
   u.arguments = {cli::input_file()};
   u.options = {
-      {"checkpoint", "FILE", "the networks: a 'checkpoint' record as qattn-train writes it", "", false, true},
+      {"checkpoint", "FILE", "the networks: a 'checkpoint' record as qattn-train writes it (required unless --keyframes)", ""},
+      {"keyframes", "FILE", "act with FILE's demonstrated keyframes (keyframe's transitions) instead of networks", ""},
       {"k", "K", "voxels expanded per non-leaf grid; 1 is C2F-ARM's greedy choice; 'auto': as many as the "
                  "node's Q volume asks for (--k-margin or --k-mass, at most --k-max)", "10"},
       {"epsilon", "E", "probability, per depth, of a random voxel instead of the chosen one", "0"},
@@ -85,6 +96,10 @@ static cli::Usage usage() {
        "--epsilon 0.1 --rotation-noise 2 | tee -a episodes.rec | plan-path > fifo",
        "an exploring actor that takes up the learner's newest weights at every episode and keeps "
        "what it saw and did"},
+      {"demo-record --task stack_wine --episodes 50 --scenes eval --output e.rec && keyframe --output e.kf e.rec && "
+       "sim-step --task stack_wine --episodes 50 --scenes eval < fifo | qte-select --keyframes e.kf | plan-path > fifo",
+       "the ceiling of learning: the demonstrations' keyframes, discretized as the networks' targets, acted on "
+       "their own scenes"},
       {"sim-step --task lift_numbered_block < /dev/null | qte-select --checkpoint ckpt.rec --k 1 --png q/ "
        "| stream-dump --type action",
        "the greedy C2F-ARM choice for one observation, and pictures of its Q-values"},
@@ -106,7 +121,19 @@ qattention::Exploration exploration_from(const cli::Arguments& args) {
 
 }  // namespace
 
+// The agent without networks (--keyframes).
+static void run_keyframes(const cli::Arguments& args) {
+  if (args.has("checkpoint")) throw UsageError("--keyframes acts without networks: leave out --checkpoint");
+  const std::string path = args.text("keyframes");
+  qattention::KeyframeStage stage(qattention::demonstrated_keyframes(path), path);
+  stream::RecordReader reader(args.input());
+  stream::RecordWriter writer(args.text("output"));
+  stream::run_stage(stage, reader, writer);
+}
+
 static void run(const cli::Arguments& args) {
+  if (args.has("keyframes")) return run_keyframes(args);
+  if (!args.has("checkpoint")) throw UsageError("--checkpoint FILE is required (or --keyframes FILE)");
   const std::string checkpoint = args.text("checkpoint");
   qattention::SelectOptions options;
   options.branching = qattention::parse_branching(args, "k", 1);

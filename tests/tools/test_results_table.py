@@ -153,6 +153,15 @@ def main():
         summed = rows_of(run("--reasons", newer, with_reasons[0]).stdout)
         assert [(r["task"], r["pushed"], r["grasp_missed"]) for r in summed] == [
             ("reasons_pick_up_cup", "", "20"), ("reasons_stack_wine", "7", "5")], summed
+        # An analysis without a seed (ceiling.sh's TASK_LABEL.csv) has its task too.
+        ceiling = os.path.join(d, "stack_wine_keyframes.csv")
+        with open(ceiling, "w") as f:
+            f.write("label,seed,episodes,success,distractor,target,elsewhere,failed_actions,wrong_object,pushed,"
+                    + ",".join(reason_columns[1:]) + "\n")
+            f.write("keyframes,,50,38,0,12,0,0,0,12,0,0,0,0,0,0,0,0,0,0,0,0\n")
+        summed = rows_of(run("--reasons", ceiling).stdout)
+        assert [(r["task"], r["label"], r["acting_k"], r["success"], r["pushed"]) for r in summed] == [
+            ("stack_wine", "keyframes", "", "38", "12")], summed
 
         # Summed per task and label: of the tries at an object (success, target, distractor),
         # the share at the right one (success, target).
