@@ -8,7 +8,8 @@
 # for the episode's 10 steps (out_of_steps); the expert's own episode of the scene sorted alone
 # is a success. Then examples/failure_reasons.sh records the expert's episodes once per key in
 # EXPERT_CACHE: a second analysis takes them from there and prints the same bytes, a
-# different image size records again, and EXPERT_CACHE= keeps nothing.
+# different image size records again, and EXPERT_CACHE= keeps nothing. The ceiling
+# (ceiling.sh: the expert's discretized keyframes) solves two reach_target scenes.
 source "$(dirname "$0")/common.sh"
 py=/usr/bin/python3
 src=${QTE_SOURCE:?set QTE_SOURCE to the repository}
@@ -130,4 +131,17 @@ analyse 32x32 elsewhere.csv "$tmp/elsewhere"
 # reach_target needs no grasp (its expert holds nothing): closing the gripper there is no grasp_missed.
 $py -c "import csv, sys; row = list(csv.DictReader(open(sys.argv[1])))[0]; sys.exit(row['grasp_missed'] != '0')" \
   "$tmp/first.csv" || fail "the analysis's columns, or a grasp missed on reach_target: $(cat "$tmp/first.csv")"
-echo "failure reasons ok: ${#reasons[@]} known episodes, the expert once per key"
+# The ceiling (examples/ceiling.sh: CHECKPOINT `keyframes`): the expert's discretized keyframes
+# solve both scenes, with no checkpoint anywhere; it keeps nothing unless EXPERT_CACHE is set,
+# and an existing CSV is kept.
+mkdir -p "$tmp/cwd/sub"
+(cd "$tmp/cwd/sub" && PATH="$tmp/bin:$PATH" IMAGE=32x32 EVAL_EPISODES=2 timeout 300 bash "$src/examples/ceiling.sh" reach_target \
+  "$tmp/ceiling/reach_target_keyframes.csv" 2> "$tmp/ceiling.err") || fail "ceiling.sh: $(cat "$tmp/ceiling.err")"
+tail -1 "$tmp/ceiling/reach_target_keyframes.csv" | grep -q "^keyframes,,2,2," \
+  || fail "the ceiling on reach_target: $(cat "$tmp/ceiling/reach_target_keyframes.csv")"
+[ "$(calls)" = 5 ] && [ -z "$(ls -A "$tmp/cwd/sub")" ] && [ ! -e "$tmp/cwd/expert-cache" ] \
+  && [ "$(ls "$tmp/ceiling")" = reach_target_keyframes.csv ] || fail "the ceiling's expert: $(calls) calls; $(ls -R "$tmp/cwd" "$tmp/ceiling")"
+touch -d 2000-01-01 "$tmp/ceiling/reach_target_keyframes.csv"
+PATH="$tmp/bin:$PATH" bash "$src/examples/ceiling.sh" reach_target "$tmp/ceiling/reach_target_keyframes.csv" \
+  && [ "$(calls)" = 5 ] && [ "$(date -r "$tmp/ceiling/reach_target_keyframes.csv" +%Y)" = 2000 ] || fail "ceiling.sh redid an existing CSV"
+echo "failure reasons ok: ${#reasons[@]} known episodes, the expert once per key, the ceiling"
