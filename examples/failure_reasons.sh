@@ -6,8 +6,8 @@
 # Usage: failure_reasons.sh TASK CHECKPOINT K [IMAGE] [EPISODES] [LABEL] [SEED] [QTE-SELECT OPTIONS...]
 #        (the built programs on PATH). CHECKPOINT `keyframes`: no networks, the expert's own
 #        keyframes on these scenes as keyframe(1) discretizes them for the learner (NET_OPTIONS:
-#        its --depths and --offset), acted with qte-select --keyframes: the ceiling of learning
-#        on this grid, planner and task. The scenes are learn.sh's evaluation scenes: VARIATION
+#        its --depths and --offset), acted with qte-select --keyframes: the discretized expert
+#        acting open-loop, a reference for what this grid, planner and task allow. The scenes are learn.sh's evaluation scenes: VARIATION
 #        (0), EVAL_SEED (1000000) and PLAN_OPTIONS as there. FAILURE_EPISODES=1: a line per episode on stderr.
 # The expert's episodes of the scenes are recorded once per task, VARIATION, EVAL_SEED,
 # EPISODES, IMAGE and demo-record program (its checksum: a rebuilt expert records again) and
@@ -36,7 +36,13 @@ if [ ! -f "$experts" ]; then  # demo-record writes its --output whole or not at 
   demo-record "${scenes[@]}" --objects --no-points --compress --output "$experts" 2>/dev/null
 fi
 if [ "$checkpoint" = keyframes ]; then
-  keyframe ${NET_OPTIONS:-} --output "$tmp/keyframes.rec" "$experts" 2>/dev/null
+  # Every scene's demonstration, failed or not (episode n acts with demonstration n), on the
+  # grids an acting network uses (no crop augmentation).
+  keyframe ${NET_OPTIONS:-} --keep-failed --no-crop-augmentation --output "$tmp/keyframes.rec" "$experts" \
+    2> "$tmp/keyframe.err" || { echo "failure_reasons.sh: keyframe: $(tail -1 "$tmp/keyframe.err")" >&2; exit 1; }
+  grep -q "^keyframe: $episodes/$episodes episodes converted" "$tmp/keyframe.err" || {
+    echo "failure_reasons.sh: $experts: keyframe converted fewer than the $episodes episodes" \
+      "(each scene needs its demonstration): $(grep -v '^ ' "$tmp/keyframe.err" | tail -2 | tr '\n' ' ')" >&2; exit 1; }
   agent=(--keyframes "$tmp/keyframes.rec")
 else
   agent=(--checkpoint "$checkpoint" --k "$k" --threads 1)

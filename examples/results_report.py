@@ -62,12 +62,14 @@ def cpu_by_role(runs):
 
 
 def ceiling_of(directory, tasks):
-    """ceiling.sh's CSVs (results/ceiling/TASK_LABEL.csv) of `tasks` at the section's grid: the
-    3-depth ones for a 3-depth takeaway, else the published 2 depths'; none for runs planned
-    without the straight approach their task now uses."""
-    if "planned-to-grasp" in directory:
+    """ceiling.sh's CSVs (results/ceiling/TASK_LABEL.csv) of `tasks` at the section's grid and
+    planner (examples/Makefile's `ceiling`): the 3-depth ones for a 3-depth takeaway, those
+    planned with the straight approach for takeaway2-long, else the tasks' own settings; none
+    for runs planned without the approach their task now uses."""
+    name = os.path.basename(directory.rstrip("/"))
+    if "planned-to-grasp" in name:
         return []
-    label = "keyframes-depths3" if "depths3" in os.path.basename(directory.rstrip("/")) else "keyframes"
+    label = "keyframes-depths3" if "depths3" in name else "keyframes-approach" if name == "takeaway2-long" else "keyframes"
     paths = [os.path.join(directory, "..", "ceiling", f"{task}_{label}.csv") for task in sorted(tasks)]
     return [p for p in paths if os.path.exists(p)]
 
@@ -103,7 +105,9 @@ def section(directory, images):
         if ceiling:
             out.append("\nThe ceiling of learning (`make -C examples ceiling`): the expert's own keyframes on the same "
                        "held-out scenes, discretized as the networks' targets (the voxel per depth, 5-degree rotation "
-                       "bins, the gripper) and acted through the same planner, what no network on this grid can beat:\n")
+                       "bins, the gripper) and acted through the agents' planner: the discretized expert acting "
+                       "open-loop, a reference for what this grid and planner allow (a network acting closed-loop "
+                       "may retry):\n")
             out.append(markdown(results_table.reasons(ceiling)))
         others = sorted(glob.glob(os.path.join(directory, "acting", "*.csv")))
         if others:

@@ -35,7 +35,7 @@ pairs were made on one processor (pairs_one_processor: both runs' machines/ file
 record copied beside the CSVs, name the same model and vector width; under a processor-time
 budget a faster processor buys more learner steps). A label compared on several tasks gets a
 further row, "all N tasks", of all its (task, seed) pairs pooled: the question of a suite ("no
-loss across Task Set 1") rather than of one task. --acting sums
+loss across Task Set 1") rather than of one task (every pair weighing the same). --acting sums
 failure_reasons CSVs per task, label (how the networks were trained) and the K they acted with:
 from the name's _act-kK suffix (learn.sh's ALSO_ACT_K), else the label's own (LABEL = ...-kK-...).
 --acting-paired BASELINE compares those cells paired by seed, with --paired's statistics: each
@@ -59,6 +59,7 @@ import os
 import re
 import statistics
 import sys
+from fractions import Fraction
 from collections import defaultdict
 
 
@@ -312,16 +313,21 @@ def t_quantile(p, df):
 def sign_flip_p(differences):
     """Two-sided p-value of the exact sign-flip permutation test of a zero mean difference: the
     share of the 2^n sign assignments whose |sum| reaches the observed one. Success rates are
-    counts over 20 or 50 episodes, so the differences lie on a grid of 1/1000, where the sums of
-    all assignments are counted by convolution for any number of pairs; off that grid they are
-    enumerated."""
-    grid = [round(d * 1000) for d in differences]
-    if any(abs(g - d * 1000) > 1e-6 for g, d in zip(grid, differences)):
+    counts over episodes, so the differences are fractions whose common denominator makes them
+    integers, and the sums of all assignments are counted by convolution for any number of
+    pairs; differences that are no such fractions are enumerated (at most 20 of them)."""
+    fractions = [Fraction(d).limit_denominator(10000) for d in differences]
+    if any(abs(float(f) - d) > 1e-9 for f, d in zip(fractions, differences)):
+        if len(differences) > 20:
+            raise ValueError(f"{len(differences)} differences that are no fractions of at most 10,000 episodes: "
+                             "too many to enumerate their 2^n sign assignments")
         observed = abs(sum(differences))
         count = 0
         for signs in itertools.product((1, -1), repeat=len(differences)):
             count += abs(sum(s * d for s, d in zip(signs, differences))) >= observed - 1e-12
         return count / 2 ** len(differences)
+    scale = math.lcm(*(f.denominator for f in fractions))
+    grid = [int(f * scale) for f in fractions]
     sums = {0: 1}  # sum of the signed differences -> number of sign assignments giving it
     for g in grid:
         following = collections.Counter()
@@ -370,7 +376,8 @@ def paired(runs, baseline):
             "rates": [(float(a["success_rate"]), float(b["success_rate"])) for a, b in pairs],
         })
     # A label compared on several tasks: all its (task, seed) pairs pooled, the question of a
-    # suite ("no loss across Task Set 1") rather than of one task.
+    # suite ("no loss across Task Set 1") rather than of one task; every pair weighs the same,
+    # so a task with more seeds counts more.
     for label in sorted({row["label"] for row in table}):
         rows = [row for row in table if row["label"] == label]
         if len(rows) < 2:

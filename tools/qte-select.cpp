@@ -64,10 +64,15 @@ static cli::Usage usage() {
       "for the learner: the voxel per depth, the rotation bins and the gripper command the "
       "networks are trained to choose. The n-th episode of the input takes FILE's n-th "
       "demonstration and its step s that demonstration's keyframe s (the last again after its "
-      "end). Run on the demonstrations' own scenes (demo-record and sim-step with the same "
-      "--task, --scenes, --seed and --image-size), it measures the best any network could "
-      "reach on this grid, planner and task: the ceiling of learning. The action's Q-values "
-      "and value are 0 and its checkpoint_step is -1.",
+      "end); ignore_collisions is --ignore-collisions', as for networks (which never choose "
+      "it), not the expert's. Run on the demonstrations' own scenes (demo-record and sim-step "
+      "with the same --task, --variation, --scenes and --seed; keyframe with the networks' "
+      "--depths and --offset, --keep-failed so that every scene has its demonstration, and "
+      "--no-crop-augmentation for the grids an acting network uses), it is the discretized "
+      "expert acting open-loop: a reference for what this grid, planner and task allow, the "
+      "ceiling of learning, though not a strict bound (a network acts closed-loop and may "
+      "retry). The action's Q-values and value are 0 and its checkpoint_step is -1; the "
+      "network options (--k, exploration, --png, --reload) are refused.",
   };
   u.arguments = {cli::input_file()};
   u.options = {
@@ -96,7 +101,8 @@ static cli::Usage usage() {
        "--epsilon 0.1 --rotation-noise 2 | tee -a episodes.rec | plan-path > fifo",
        "an exploring actor that takes up the learner's newest weights at every episode and keeps "
        "what it saw and did"},
-      {"demo-record --task stack_wine --episodes 50 --scenes eval --output e.rec && keyframe --output e.kf e.rec && "
+      {"demo-record --task stack_wine --episodes 50 --scenes eval --output e.rec && "
+       "keyframe --keep-failed --no-crop-augmentation --output e.kf e.rec && "
        "sim-step --task stack_wine --episodes 50 --scenes eval < fifo | qte-select --keyframes e.kf | plan-path > fifo",
        "the ceiling of learning: the demonstrations' keyframes, discretized as the networks' targets, acted on "
        "their own scenes"},
@@ -123,9 +129,11 @@ qattention::Exploration exploration_from(const cli::Arguments& args) {
 
 // The agent without networks (--keyframes).
 static void run_keyframes(const cli::Arguments& args) {
-  if (args.has("checkpoint")) throw UsageError("--keyframes acts without networks: leave out --checkpoint");
+  for (const char* option : {"checkpoint", "k", "epsilon", "index-noise", "rotation-noise", "gripper-flip", "reload", "png"})
+    if (args.has(option))
+      throw UsageError(std::string("--keyframes acts without networks: leave out --") + option);
   const std::string path = args.text("keyframes");
-  qattention::KeyframeStage stage(qattention::demonstrated_keyframes(path), path);
+  qattention::KeyframeStage stage(qattention::demonstrated_keyframes(path), path, args.flag("ignore-collisions"));
   stream::RecordReader reader(args.input());
   stream::RecordWriter writer(args.text("output"));
   stream::run_stage(stage, reader, writer);

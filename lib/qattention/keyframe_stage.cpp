@@ -19,17 +19,16 @@ KeyframeAction keyframe_action(const stream::Record& t) {
     const std::string prefix = "depth" + std::to_string(d);
     const auto index = t.array<int32_t>(prefix + ".index");
     if (index.size() != 3) t.fail(prefix + ".index", "int32 [3]");
-    a.choice.indices.emplace_back(index[0], index[1], index[2]);
-    a.choice.bounds.push_back(voxels::bounds_field(t, prefix + ".bounds", voxels));
-    if (!a.choice.bounds.back().contains(a.choice.indices.back())) t.fail(prefix + ".index", "a voxel of its grid");
-    a.choice.q_values.push_back(0);
+    a.indices.emplace_back(index[0], index[1], index[2]);
+    a.bounds.push_back(voxels::bounds_field(t, prefix + ".bounds", voxels));
+    if (!a.bounds.back().contains(a.indices.back())) t.fail(prefix + ".index", "a voxel of its grid");
+    a.q_values.push_back(0);
   }
-  if (a.choice.indices.empty()) t.fail("depth0.index", "int32 [3]: a transition as keyframe(1) writes it");
+  if (a.indices.empty()) t.fail("depth0.index", "int32 [3]: a transition as keyframe(1) writes it");
   const auto bins = t.array<int32_t>("rotation_bins");
   if (bins.size() != 3) t.fail("rotation_bins", "int32 [3]");
-  a.choice.rotation_bins = Eigen::Vector3i(bins[0], bins[1], bins[2]);
-  a.choice.gripper_open = t.scalar<uint8_t>("gripper_open") != 0;
-  a.ignore_collisions = t.has("ignore_collisions") && t.scalar<uint8_t>("ignore_collisions") != 0;
+  a.rotation_bins = Eigen::Vector3i(bins[0], bins[1], bins[2]);
+  a.gripper_open = t.scalar<uint8_t>("gripper_open") != 0;
   return a;
 }
 
@@ -52,26 +51,33 @@ std::vector<std::vector<KeyframeAction>> demonstrated_keyframes(const std::strin
   for (int64_t key : order) {
     auto& by_frame = episodes[key];
     std::vector<KeyframeAction> chain;
-    // From the first frame along next_frame: the keyframes (a frame's transition leads to the next).
-    for (auto it = by_frame.find(0); it != by_frame.end() && chain.size() <= by_frame.size();
-         it = by_frame.find(it->second.scalar<int32_t>("next_frame"))) {
-      chain.push_back(keyframe_action(it->second));
-      if (it->second.scalar<uint8_t>("terminal") != 0) break;
+    // From the first frame along next_frame to the terminal transition: the keyframes.
+    auto it = by_frame.find(0);
+    if (it == by_frame.end()) by_frame.begin()->second.fail("frame", "a transition from frame 0 (the episode's first)");
+    while (true) {
+      const stream::Record& t = it->second;
+      chain.push_back(keyframe_action(t));
+      if (t.scalar<uint8_t>("terminal") != 0) break;
+      if (chain.size() > by_frame.size()) t.fail("next_frame", "a chain of keyframes that ends (this one loops)");
+      it = by_frame.find(t.scalar<int32_t>("next_frame"));
+      if (it == by_frame.end())
+        t.fail("next_frame", "a frame with a transition from it, up to a terminal one (the chain breaks off here)");
     }
-    if (chain.empty()) by_frame.begin()->second.fail("frame", "a transition from frame 0 (the episode's first)");
     demonstrations.push_back(std::move(chain));
   }
   return demonstrations;
 }
 
-KeyframeStage::KeyframeStage(std::vector<std::vector<KeyframeAction>> demonstrations, std::string source)
-    : demonstrations_(std::move(demonstrations)), source_(std::move(source)) {}
+KeyframeStage::KeyframeStage(std::vector<std::vector<KeyframeAction>> demonstrations, std::string source,
+                             bool ignore_collisions)
+    : demonstrations_(std::move(demonstrations)), source_(std::move(source)), ignore_collisions_(ignore_collisions) {}
 
 void KeyframeStage::handle(const stream::Record& record, const stream::Emit& emit) {
   emit(record);
   if (record.type() != "obs") return;
   if (record.has("terminal") && record.scalar<uint8_t>("terminal") != 0) return;
   const int32_t step = record.scalar<int32_t>("step");
+  if (step < 0) record.fail("step", "a step of 0 or more");
   if (step == 0) episode_ += 1;
   if (episode_ < 0) record.fail("step", "0 at an episode's first observation");
   if (episode_ >= static_cast<int64_t>(demonstrations_.size()))
@@ -79,7 +85,7 @@ void KeyframeStage::handle(const stream::Record& record, const stream::Emit& emi
                             std::to_string(demonstrations_.size()) + " demonstrations");
   const auto& keyframes = demonstrations_[episode_];
   const KeyframeAction& a = keyframes[std::min<std::size_t>(step, keyframes.size() - 1)];
-  emit(action_record(a.choice, a.ignore_collisions, 1, false, -1, step));
+  emit(action_record(a, ignore_collisions_, 1, false, -1, step));
 }
 
 }  // namespace qte::qattention

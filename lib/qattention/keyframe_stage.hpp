@@ -1,7 +1,9 @@
 // An agent without networks: it acts with demonstrated keyframes as keyframe(1) discretized
-// them for the learner, the actions the networks are trained to choose. Run in the acting loop
-// on the demonstrations' own scenes, it measures what a network could reach at best on this
-// grid, planner and task: the ceiling of learning (qte-select --keyframes).
+// them for the learner, the voxels, rotation bins and gripper commands the networks are trained
+// to choose. Run in the acting loop on the demonstrations' own scenes, it is the discretized
+// expert acting open-loop: a reference for what this grid, planner and task allow (the
+// ceiling of learning, qte-select --keyframes), not a strict bound on a network, which acts
+// closed-loop and may retry.
 #pragma once
 
 #include <string>
@@ -12,14 +14,14 @@
 
 namespace qte::qattention {
 
-struct KeyframeAction {
-  Choice choice;  // the voxel per depth, its grid's bounds, the rotation bins, the gripper
-  bool ignore_collisions = false;
-};
+// The voxel per depth, its grid's bounds, the rotation bins, the gripper (not the expert's
+// ignore_collisions: the networks never choose it).
+using KeyframeAction = Choice;
 
 // Per demonstration, in the order of the file: its keyframes' actions, in order (the chain of
-// transitions from frame 0 along next_frame; demo augmentation's transitions from the frames
-// between keyframes are left out). Fails naming the file on anything else.
+// transitions from frame 0 along next_frame to the terminal one; demo augmentation's
+// transitions from the frames between keyframes are left out). Fails naming the file, record
+// and byte offset on anything else (a chain that breaks off or loops).
 std::vector<std::vector<KeyframeAction>> demonstrated_keyframes(const std::string& transitions_path);
 
 // Every record passes through; after each non-terminal 'obs' an 'action' record: the n-th
@@ -27,12 +29,14 @@ std::vector<std::vector<KeyframeAction>> demonstrated_keyframes(const std::strin
 // its keyframe s, the last one again after its end.
 class KeyframeStage : public stream::Stage {
  public:
-  KeyframeStage(std::vector<std::vector<KeyframeAction>> demonstrations, std::string source);
+  // `ignore_collisions`: every action's, as qte-select --ignore-collisions sets it for networks.
+  KeyframeStage(std::vector<std::vector<KeyframeAction>> demonstrations, std::string source, bool ignore_collisions);
   void handle(const stream::Record& record, const stream::Emit& emit) override;
 
  private:
   std::vector<std::vector<KeyframeAction>> demonstrations_;
   std::string source_;
+  bool ignore_collisions_;
   int64_t episode_ = -1;
 };
 

@@ -232,13 +232,20 @@ def main():
         assert pooled[2]["mean_difference"] == f"{mean:+.3f}", pooled[2]
         assert pooled[2]["sign_flip_p"] == f"{brute:.4f}", (pooled[2], brute)
         assert pooled[2]["mean_success"] == f"{statistics.mean(q for _, q in reach + lid) / 50:.3f}"
-        # Rates off that grid (3 episodes: thirds) are enumerated: the same p either way.
+        # Rates over 3 episodes (thirds) are counted on their common denominator, differences that
+        # are no such fractions enumerated: both as the brute force here; too many of the latter
+        # to enumerate are refused.
         sys.path.insert(0, os.path.dirname(SCRIPT))
         import results_table
-        thirds = [1 / 3, -2 / 3, 1.0, 2 / 3, 1 / 3]
-        sums = [abs(sum(s * x for s, x in zip(signs, thirds)))
-                for signs in __import__("itertools").product((1, -1), repeat=5)]
-        assert results_table.sign_flip_p(thirds) == sum(v >= abs(sum(thirds)) - 1e-9 for v in sums) / 32
+        for values in ([1 / 3, -2 / 3, 1.0, 2 / 3, 1 / 3], [0.1234567, -0.0712345, 0.3141593, 0.0271828, -0.0141421]):
+            sums = [abs(sum(s * x for s, x in zip(signs, values)))
+                    for signs in __import__("itertools").product((1, -1), repeat=5)]
+            assert results_table.sign_flip_p(values) == sum(v >= abs(sum(values)) - 1e-9 for v in sums) / 32, values
+        try:
+            results_table.sign_flip_p([0.1234567] * 21)
+            raise AssertionError("21 differences off every grid were enumerated")
+        except ValueError as e:
+            assert "too many to enumerate" in str(e), e
 
         # Pairs made on one processor, from learn.sh's machine files in machines/: seeds 0 and 1
         # both runs on one (seed 1's QTE run resumed on it), seed 2 on two kinds, seed 3's C2F-ARM
