@@ -51,7 +51,6 @@ older file's reason columns are empty).
 Standard library only.
 """
 import argparse
-import collections
 import csv
 import itertools
 import math
@@ -59,8 +58,8 @@ import os
 import re
 import statistics
 import sys
+from collections import Counter, defaultdict
 from fractions import Fraction
-from collections import defaultdict
 
 
 def label_settings(label):
@@ -330,7 +329,7 @@ def sign_flip_p(differences):
     grid = [int(f * scale) for f in fractions]
     sums = {0: 1}  # sum of the signed differences -> number of sign assignments giving it
     for g in grid:
-        following = collections.Counter()
+        following = Counter()
         for total, count in sums.items():
             following[total + g] += count
             following[total - g] += count

@@ -1,10 +1,11 @@
 #include "qattention/keyframe_stage.hpp"
 
-#include <map>
+#include <optional>
 #include <utility>
 
 #include "common/error.hpp"
 #include "qattention/action_record.hpp"
+#include "replay/replay_buffer.hpp"
 #include "stream/reader.hpp"
 #include "voxels/grid_fields.hpp"
 
@@ -12,8 +13,8 @@ namespace qte::qattention {
 
 namespace {
 
-KeyframeAction keyframe_action(const stream::Record& t) {
-  KeyframeAction a;
+Choice keyframe_action(const stream::Record& t) {
+  Choice a;
   const int voxels = t.scalar<int32_t>("voxels");
   for (int d = 0; t.has("depth" + std::to_string(d) + ".index"); ++d) {
     const std::string prefix = "depth" + std::to_string(d);
@@ -34,41 +35,42 @@ KeyframeAction keyframe_action(const stream::Record& t) {
 
 }  // namespace
 
-std::vector<std::vector<KeyframeAction>> demonstrated_keyframes(const std::string& transitions_path) {
-  // Per episode (in the order of its first transition): each transition by the frame it starts from.
-  std::vector<int64_t> order;
-  std::map<int64_t, std::map<int32_t, stream::Record>> episodes;
+std::vector<std::vector<Choice>> demonstrated_keyframes(const std::string& transitions_path) {
+  // The learner's replay follows the chains: sized to hold every transition, in file order.
+  std::vector<stream::Record> records;
+  std::size_t transitions = 0;
   stream::RecordReader reader(transitions_path);
   while (auto record = reader.next()) {
-    if (record->type() != "transition") continue;
-    const int64_t key = record->scalar<int64_t>("episode_key");
-    if (!episodes.count(key)) order.push_back(key);
-    const int32_t frame = record->scalar<int32_t>("frame");
-    episodes[key].insert_or_assign(frame, std::move(*record));
+    if (record->type() != "frame" && record->type() != "transition") continue;
+    transitions += record->type() == "transition";
+    records.push_back(std::move(*record));
   }
-  if (order.empty()) throw Error(transitions_path + ": no 'transition' records: expected keyframe(1)'s output");
-  std::vector<std::vector<KeyframeAction>> demonstrations;
-  for (int64_t key : order) {
-    auto& by_frame = episodes[key];
-    std::vector<KeyframeAction> chain;
-    // From the first frame along next_frame to the terminal transition: the keyframes.
-    auto it = by_frame.find(0);
-    if (it == by_frame.end()) by_frame.begin()->second.fail("frame", "a transition from frame 0 (the episode's first)");
+  if (transitions == 0) throw Error(transitions_path + ": no 'transition' records: expected keyframe(1)'s output");
+  replay::ReplayBuffer buffer({transitions, false});
+  for (const stream::Record& record : records) buffer.add(record);
+  records.clear();
+  // A demonstration's chain starts at its first frame, step 0, and goes keyframe by keyframe
+  // (successor_of) to its terminal transition; demo augmentation's chains start elsewhere.
+  std::vector<std::vector<Choice>> demonstrations;
+  for (std::size_t first = 0; first < buffer.size(); ++first) {
+    const stream::Record& start = buffer.transition(first);
+    if (start.scalar<int32_t>("frame") != 0 || start.scalar<int32_t>("step") != 0) continue;
+    std::vector<Choice> chain;
+    std::optional<std::size_t> t = first;
     while (true) {
-      const stream::Record& t = it->second;
-      chain.push_back(keyframe_action(t));
-      if (t.scalar<uint8_t>("terminal") != 0) break;
-      if (chain.size() > by_frame.size()) t.fail("next_frame", "a chain of keyframes that ends (this one loops)");
-      it = by_frame.find(t.scalar<int32_t>("next_frame"));
-      if (it == by_frame.end())
-        t.fail("next_frame", "a frame with a transition from it, up to a terminal one (the chain breaks off here)");
+      const stream::Record& transition = buffer.transition(*t);
+      chain.push_back(keyframe_action(transition));
+      if (transition.scalar<uint8_t>("terminal") != 0) break;
+      t = buffer.successor_of(*t);
+      if (!t)
+        transition.fail("next_frame", "a frame with a transition from it, up to a terminal one (the chain breaks off here)");
     }
     demonstrations.push_back(std::move(chain));
   }
   return demonstrations;
 }
 
-KeyframeStage::KeyframeStage(std::vector<std::vector<KeyframeAction>> demonstrations, std::string source,
+KeyframeStage::KeyframeStage(std::vector<std::vector<Choice>> demonstrations, std::string source,
                              bool ignore_collisions)
     : demonstrations_(std::move(demonstrations)), source_(std::move(source)), ignore_collisions_(ignore_collisions) {}
 
@@ -84,7 +86,7 @@ void KeyframeStage::handle(const stream::Record& record, const stream::Emit& emi
     record.fail("step", "at most " + std::to_string(demonstrations_.size()) + " episodes: " + source_ + " holds " +
                             std::to_string(demonstrations_.size()) + " demonstrations");
   const auto& keyframes = demonstrations_[episode_];
-  const KeyframeAction& a = keyframes[std::min<std::size_t>(step, keyframes.size() - 1)];
+  const Choice& a = keyframes[std::min<std::size_t>(step, keyframes.size() - 1)];
   emit(action_record(a, ignore_collisions_, 1, false, -1, step));
 }
 

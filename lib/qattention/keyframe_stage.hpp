@@ -14,15 +14,12 @@
 
 namespace qte::qattention {
 
-// The voxel per depth, its grid's bounds, the rotation bins, the gripper (not the expert's
-// ignore_collisions: the networks never choose it).
-using KeyframeAction = Choice;
-
-// Per demonstration, in the order of the file: its keyframes' actions, in order (the chain of
-// transitions from frame 0 along next_frame to the terminal one; demo augmentation's
-// transitions from the frames between keyframes are left out). Fails naming the file, record
-// and byte offset on anything else (a chain that breaks off or loops).
-std::vector<std::vector<KeyframeAction>> demonstrated_keyframes(const std::string& transitions_path);
+// Per demonstration, in the order of the file: its keyframes' actions (the voxel per depth, its
+// grid's bounds, the rotation bins, the gripper; not the expert's ignore_collisions, which the
+// networks never choose), in order: the chain of transitions from frame 0 to the terminal one
+// (demo augmentation's chains from the frames between keyframes are left out). Fails naming
+// the file, record and byte offset on anything else (a chain that breaks off).
+std::vector<std::vector<Choice>> demonstrated_keyframes(const std::string& transitions_path);
 
 // Every record passes through; after each non-terminal 'obs' an 'action' record: the n-th
 // episode of the input (an observation with step 0 starts one) takes demonstration n, step s
@@ -30,11 +27,11 @@ std::vector<std::vector<KeyframeAction>> demonstrated_keyframes(const std::strin
 class KeyframeStage : public stream::Stage {
  public:
   // `ignore_collisions`: every action's, as qte-select --ignore-collisions sets it for networks.
-  KeyframeStage(std::vector<std::vector<KeyframeAction>> demonstrations, std::string source, bool ignore_collisions);
+  KeyframeStage(std::vector<std::vector<Choice>> demonstrations, std::string source, bool ignore_collisions);
   void handle(const stream::Record& record, const stream::Emit& emit) override;
 
  private:
-  std::vector<std::vector<KeyframeAction>> demonstrations_;
+  std::vector<std::vector<Choice>> demonstrations_;
   std::string source_;
   bool ignore_collisions_;
   int64_t episode_ = -1;
