@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "common/error.hpp"
 
@@ -68,6 +69,30 @@ struct PenetrationCallback : btCollisionWorld::ContactResultCallback {
   btScalar addSingleResult(btManifoldPoint& point, const btCollisionObjectWrapper*, int, int,
                            const btCollisionObjectWrapper*, int, int) override {
     if (point.getDistance() < -tolerance_m) touching = true;
+    return 0;
+  }
+};
+
+// How far a held object must slip back in the grip (along `back`, the reverse of the
+// gripper's approach) to leave what it presses on: the deepest contact, deeper than
+// `tolerance_m`, whose obstacle pushes it back along the approach rather than sideways.
+struct SlipCallback : btCollisionWorld::ContactResultCallback {
+  const btCollisionObject* held;
+  std::function<bool(const btCollisionObject*)> is_obstacle;
+  btVector3 back;
+  double tolerance_m;
+  double slip_m = 0;
+  SlipCallback(const btCollisionObject* held_object, std::function<bool(const btCollisionObject*)> obstacle,
+               const btVector3& back_direction, double tolerance)
+      : held(held_object), is_obstacle(std::move(obstacle)), back(back_direction), tolerance_m(tolerance) {}
+  btScalar addSingleResult(btManifoldPoint& point, const btCollisionObjectWrapper* a, int, int,
+                           const btCollisionObjectWrapper* b, int, int) override {
+    const bool held_is_a = a->getCollisionObject() == held;
+    if (!is_obstacle(held_is_a ? b->getCollisionObject() : a->getCollisionObject())) return 0;
+    // The normal on B points from B to A: turned to point out of the obstacle, into the held object.
+    const btVector3 out = held_is_a ? point.m_normalWorldOnB : -point.m_normalWorldOnB;
+    const double along = out.dot(back), depth = -point.getDistance();
+    if (depth > tolerance_m && along > 0.5) slip_m = std::max(slip_m, depth / along);
     return 0;
   }
 };
@@ -251,6 +276,30 @@ void World::place_robot_links() {
     const btTransform t = to_bullet(base * poses[robot_.tcp_link()] * held_from_tcp_);
     body->getMotionState()->setWorldTransform(t);
     body->setWorldTransform(t);
+    slip_held_object();
+  }
+}
+
+void World::slip_held_object() {
+  auto& body = *impl_->objects[held_].body;
+  const auto is_obstacle = [this](const btCollisionObject* other) {
+    if (other == impl_->table.body.get()) return true;
+    for (int id = 0; id < object_count(); ++id)
+      if (other == impl_->objects[id].body.get()) return id != held_ && impl_->specs[id].collides;
+    return false;  // robot links: the fingers hold it
+  };
+  const Eigen::Vector3d back = -tcp_pose().linear().col(2);
+  double slipped = 0;
+  for (int pass = 0; pass < 3; ++pass) {  // a slip out of one obstacle may press into another
+    SlipCallback contacts(&body, is_obstacle, btVector3(back.x(), back.y(), back.z()), kSlipTolerance_m);
+    impl_->world.contactTest(&body, contacts);
+    if (contacts.slip_m == 0 || slipped + contacts.slip_m > kMaxSlip_m) break;
+    slipped += contacts.slip_m;
+    const Eigen::Isometry3d moved = Eigen::Translation3d(contacts.slip_m * back) * object_pose(held_);
+    held_from_tcp_ = tcp_pose().inverse() * moved;
+    const btTransform t = to_bullet(moved);
+    body.getMotionState()->setWorldTransform(t);
+    body.setWorldTransform(t);
   }
 }
 

@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include "common/error.hpp"
+#include "sim_step/trajectory_helpers.hpp"
+#include "tasks/task.hpp"
 #include "world/world.hpp"
 #include "test_support.hpp"
 
@@ -74,4 +76,75 @@ TEST(World, ObjectBoxesAreTheShapesOwnBoundsInTheObjectFrame) {
   expect_box("sphere", {-0.03, -0.03, -0.03}, {0.03, 0.03, 0.03});
   expect_box("hull", {0, 0, 0}, {0.05, 0.02, 0.07});
   expect_box("compound", {-0.01, -0.01, 0}, {0.11, 0.01, 0.06});
+}
+
+namespace {
+
+// A 4 cm box held from above at its centre, 10 cm over a static slab whose top is at `slab_top`.
+struct HeldOverSlab {
+  world::World world{test_support::xarm()};
+  int box = -1;
+  double slab_top = 0;
+  HeldOverSlab() {
+    const double table = world.layout().table_height_m;
+    world::ObjectSpec slab, held;
+    slab.name = "slab";
+    slab.size = Eigen::Vector3d(0.2, 0.2, 0.02);
+    slab.pose.translation() << 0.15, 0.0, table + 0.01;
+    slab.mass_kg = 0;
+    slab_top = table + 0.02;
+    held.name = "box";
+    held.size = Eigen::Vector3d(0.04, 0.04, 0.04);
+    held.pose.translation() << 0.15, 0.0, slab_top + 0.12;
+    world.add_object(slab);
+    box = world.add_object(held);
+    world.set_robot_state(test_support::ik_world(world, tcp_at(slab_top + 0.12)), 0.085);
+    EXPECT_EQ(world.close_gripper(), box);
+  }
+  static Eigen::Isometry3d tcp_at(double z) {
+    Eigen::Isometry3d tcp = Eigen::Isometry3d::Identity();
+    tcp.linear() = tasks::top_down(0);
+    tcp.translation() << 0.15, 0.0, z;
+    return tcp;
+  }
+  double box_bottom() const { return world.object_pose(box).translation().z() - 0.02; }
+};
+
+}  // namespace
+
+// What a held object is pressed onto stops it: it slips up in the grip rather than go into the
+// slab, stays held, and rests on the slab when let go.
+TEST(World, AHeldObjectPressedOntoSomethingSlipsInTheGripInsteadOfEnteringIt) {
+  HeldOverSlab scene;
+  // Down until the box's centre would be 1.5 cm below the slab's top + 2 cm: 1.5 cm into it.
+  scene.world.step_towards(test_support::ik_world(scene.world, HeldOverSlab::tcp_at(scene.slab_top + 0.005)),
+                           scene.world.finger_opening_m(), 1.0);
+  EXPECT_EQ(scene.world.held_object(), scene.box);
+  EXPECT_NEAR(scene.box_bottom(), scene.slab_top, world::World::kSlipTolerance_m + 0.001);
+  const double tcp_z = scene.world.tcp_pose().translation().z();
+  EXPECT_NEAR(tcp_z, scene.slab_top + 0.005, 0.002);  // the gripper went on down
+  scene.world.open_gripper();
+  scene.world.settle(0.5);
+  EXPECT_NEAR(scene.box_bottom(), scene.slab_top, 0.002);
+}
+
+// Pressing sideways is not a slip: a held object swept into a standing one pushes it and keeps
+// its own place in the grip.
+TEST(World, AHeldObjectSweptSidewaysPushesWhatItMeetsAndKeepsItsGrip) {
+  HeldOverSlab scene;
+  world::ObjectSpec standing;
+  standing.name = "standing";
+  standing.size = Eigen::Vector3d(0.03, 0.03, 0.06);
+  standing.pose.translation() << 0.15, 0.06, scene.slab_top + 0.03 + world::kHullMargin;
+  const int other = scene.world.add_object(standing);
+  scene.world.step_towards(test_support::ik_world(scene.world, HeldOverSlab::tcp_at(scene.slab_top + 0.03)),
+                           scene.world.finger_opening_m(), 0.5);
+  const Eigen::Isometry3d in_grip = scene.world.tcp_pose().inverse() * scene.world.object_pose(scene.box);
+  const Eigen::Vector3d start = scene.world.object_pose(other).translation();
+  Eigen::Isometry3d tcp = HeldOverSlab::tcp_at(scene.slab_top + 0.03);
+  tcp.translation().y() += 0.1;
+  scene.world.step_towards(test_support::ik_world(scene.world, tcp), scene.world.finger_opening_m(), 1.0);
+  EXPECT_GT((scene.world.object_pose(other).translation() - start).norm(), 0.02);
+  const Eigen::Isometry3d after = scene.world.tcp_pose().inverse() * scene.world.object_pose(scene.box);
+  EXPECT_NEAR((after.translation() - in_grip.translation()).norm(), 0.0, 1e-6);
 }
