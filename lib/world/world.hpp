@@ -80,7 +80,7 @@ class World {
   // Moves the robot kinematically to (q, opening) over dt_s seconds of physics, so objects
   // in the way are pushed. A held object moves with the gripper, except that what it is
   // pressed onto stops it: it slips back in the grip along the approach (a place pose below
-  // a board's top leaves the checker on the board, not in it), up to kMaxSlip_m.
+  // a board's top leaves the checker on the board, not in it).
   void step_towards(const robot::JointVector& q, double finger_opening_m, double dt_s);
   // Physics only (objects settle), the robot standing still.
   void settle(double seconds);
@@ -103,7 +103,8 @@ class World {
   const btCollisionWorld& collision_world() const;
   static constexpr double kPhysicsStep = 1.0 / 240.0;
   // A held object presses this deep into something before it slips (resting contacts and
-  // hull margins stay below it); it slips at most kMaxSlip_m in all (beyond, it is carried).
+  // hull margins stay below it); it slips at most kMaxSlip_m at a physics step (a deeper
+  // contact, as after a teleport into something, is left as it is).
   static constexpr double kSlipTolerance_m = 0.001, kMaxSlip_m = 0.03;
 
  private:
