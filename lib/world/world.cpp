@@ -273,14 +273,15 @@ void World::place_robot_links() {
   }
   if (held_ >= 0) {
     auto& body = impl_->objects[held_].body;
-    const btTransform t = to_bullet(base * poses[robot_.tcp_link()] * held_from_tcp_);
+    const Eigen::Isometry3d tcp = base * poses[robot_.tcp_link()];
+    const btTransform t = to_bullet(tcp * held_from_tcp_);
     body->getMotionState()->setWorldTransform(t);
     body->setWorldTransform(t);
-    slip_held_object();
+    slip_held_object(tcp);
   }
 }
 
-void World::slip_held_object() {
+void World::slip_held_object(const Eigen::Isometry3d& tcp) {
   auto& body = *impl_->objects[held_].body;
   const auto is_obstacle = [this](const btCollisionObject* other) {
     if (other == impl_->table.body.get()) return true;
@@ -288,7 +289,7 @@ void World::slip_held_object() {
       if (other == impl_->objects[id].body.get()) return id != held_ && impl_->specs[id].collides;
     return false;  // robot links: the fingers hold it
   };
-  const Eigen::Vector3d back = -tcp_pose().linear().col(2);
+  const Eigen::Vector3d back = -tcp.linear().col(2);
   double slipped = 0;
   for (int pass = 0; pass < 3; ++pass) {  // a slip out of one obstacle may press into another
     SlipCallback contacts(&body, is_obstacle, btVector3(back.x(), back.y(), back.z()), kSlipTolerance_m);
@@ -296,7 +297,7 @@ void World::slip_held_object() {
     if (contacts.slip_m == 0 || slipped + contacts.slip_m > kMaxSlip_m) break;
     slipped += contacts.slip_m;
     const Eigen::Isometry3d moved = Eigen::Translation3d(contacts.slip_m * back) * object_pose(held_);
-    held_from_tcp_ = tcp_pose().inverse() * moved;
+    held_from_tcp_ = tcp.inverse() * moved;
     const btTransform t = to_bullet(moved);
     body.getMotionState()->setWorldTransform(t);
     body.setWorldTransform(t);

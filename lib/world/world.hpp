@@ -119,7 +119,7 @@ class World {
   Eigen::Isometry3d held_from_tcp_ = Eigen::Isometry3d::Identity();
 
   void place_robot_links();
-  void slip_held_object();
+  void slip_held_object(const Eigen::Isometry3d& tcp);  // tcp: the pose just placed (world frame)
   void physics_substep();
 };
 
