@@ -2,7 +2,7 @@
 """Which depth decided: per depth, where the agent's chosen voxels lie — on the target, on a
 lookalike (a distractor) or elsewhere — and how often a finer depth overruled depth 0.
 
-    depth_decisions.py AGENT.rec [--label L] [--step N]
+    depth_decisions.py AGENT.rec [--label L] [--step N] [--actions OUT.csv]
 
 AGENT.rec: the agent's episodes, observations written with the simulator's objects (sim-step
 --objects) and qte-select's actions after them (depth_decisions.sh records them). Each action
@@ -21,9 +21,17 @@ Printed as CSV, one row per line of the table:
                        finer depth overruled it; never with K = 1), the chosen voxel
     overruled_argmax   of those actions, depth 0's argmax
 with the columns label, k (the actions' K), row, actions, target, lookalike, elsewhere and the
-three shares (empty when a row has no actions). Run with Debian's python3."""
+three shares (empty when a row has no actions).
+
+--actions OUT.csv: one row per judged action, to find a decision worth looking at: action (its
+index among the stream's actions, the n of qte-select --png's <n>.depth<d>.png), obs_record
+(the index of its observation in the stream, stream-png's <record index>.front.rgb.png),
+episode_seed, step, k, overruled (1 when the chosen depth-0 voxel is not depth 0's argmax) and
+the place of each row depth<d> and depth0_argmax. Run with Debian's python3."""
 import argparse
+import collections
 import csv
+import os
 import sys
 
 import numpy as np
@@ -62,13 +70,18 @@ def place(found, point, edge):
     return {"target": "target", "distractor": "lookalike"}.get(on.role if on else None, "elsewhere")
 
 
+Decision = collections.namedtuple("Decision", "k rows action obs_record episode_seed step")
+
+
 def decisions(records, step=None):
-    """Per action the agent took greedily: (k, {row: place}), each judged against the objects of
-    the observation before it."""
-    found, out = None, []
+    """Per action the agent took greedily: a Decision (k, {row: place} and where it is in the
+    stream), each judged against the objects of the observation before it."""
+    found, out, n_actions = None, [], 0
     for r in records:
+        if r.type == "action":
+            n_actions += 1
         if r.type == "obs":
-            found = task_objects(r)
+            found, obs = task_objects(r), r
             obs_step = int(scalar(r, "step", -1))
             if found is None:
                 sys.exit(f"record {r.index}: an observation without objects.*: record the episodes with "
@@ -88,17 +101,33 @@ def decisions(records, step=None):
             if not np.array_equal(np.asarray(argmax), np.asarray(r.fields["depth0.index"])):
                 rows["overruled"] = rows["depth0"]
                 rows["overruled_argmax"] = rows["depth0_argmax"]
-        out.append((int(scalar(r, "k", 1)), rows))
+        out.append(Decision(int(scalar(r, "k", 1)), rows, n_actions - 1, obs.index,
+                            int(scalar(obs, "episode_seed", -1)), obs_step))
     return out
+
+
+def depth_rows(taken):
+    """depth0 ... depth<D-1>, depth0_argmax: the rows every action has."""
+    depths = max((int(name[5:]) for t in taken for name in t.rows if name[5:].isdigit()), default=-1) + 1
+    return [f"depth{d}" for d in range(depths)] + ["depth0_argmax"]
+
+
+def write_actions(taken, path):
+    names = depth_rows(taken)
+    with open(path + ".tmp", "w", newline="") as f:
+        out = csv.writer(f, lineterminator="\n")
+        out.writerow(["action", "obs_record", "episode_seed", "step", "k", "overruled"] + names)
+        for t in taken:
+            out.writerow([t.action, t.obs_record, t.episode_seed, t.step, t.k, int("overruled" in t.rows)]
+                         + [t.rows.get(name, "") for name in names])
+    os.replace(path + ".tmp", path)  # whole or not at all
 
 
 def table(taken):
     """{row: {place: count}} in the order of the module's text; the overruled rows always."""
-    depths = max((int(name[5:]) for _, rows in taken for name in rows if name[5:].isdigit()), default=-1) + 1
-    names = [f"depth{d}" for d in range(depths)] + ["depth0_argmax", "overruled", "overruled_argmax"]
-    counts = {name: dict.fromkeys(PLACES, 0) for name in names}
-    for _, rows in taken:
-        for name, where in rows.items():
+    counts = {name: dict.fromkeys(PLACES, 0) for name in depth_rows(taken) + ["overruled", "overruled_argmax"]}
+    for decision in taken:
+        for name, where in decision.rows.items():
             counts[name][where] += 1
     return counts
 
@@ -108,11 +137,14 @@ def main():
     parser.add_argument("agent")
     parser.add_argument("--label", default="")
     parser.add_argument("--step", type=int, default=None, help="only the actions chosen at observations of step N")
+    parser.add_argument("--actions", help="also write one row per judged action to this CSV file")
     args = parser.parse_args()
     taken = decisions(read_records(args.agent), args.step)
     if not taken:
         sys.exit(f"{args.agent}: no greedy actions after observations with objects")
-    ks = sorted({k for k, _ in taken})
+    if args.actions:
+        write_actions(taken, args.actions)
+    ks = sorted({t.k for t in taken})
     out = csv.writer(sys.stdout, lineterminator="\n")
     out.writerow(["label", "k", "row", "actions"] + PLACES + [p + "_share" for p in PLACES])
     for name, count in table(taken).items():

@@ -5,9 +5,11 @@ judged as the rule says (on the box, within half a voxel of it, above it, beside
 box's corner, on the zone: elsewhere); a stream of actions gives the table by depth, the
 depth-0 argmax row and the overruled rows; failure_reasons sorts episodes by these objects, not
 by points. Run with Debian's python3 (NumPy)."""
+import csv
 import math
 import os
 import sys
+import tempfile
 
 import numpy as np
 
@@ -109,6 +111,20 @@ check("depth0_argmax", counts["depth0_argmax"], {"target": 3, "lookalike": 2, "e
 check("overruled", counts["overruled"], {"target": 1, "lookalike": 0, "elsewhere": 1})
 check("overruled_argmax", counts["overruled_argmax"], {"target": 1, "lookalike": 1, "elsewhere": 0})
 check("--step 1", dd.table(dd.decisions(stream, 1))["overruled"], {"target": 1, "lookalike": 0, "elsewhere": 0})
+# --actions: a row per judged action, the explored one left out but counted in the indices
+# (qte-select --png numbers every action it writes).
+with tempfile.TemporaryDirectory() as tmp:
+    dd.write_actions(taken, os.path.join(tmp, "actions.csv"))
+    with open(os.path.join(tmp, "actions.csv")) as f:
+        rows = list(csv.DictReader(f))
+    check("--actions files", os.listdir(tmp), ["actions.csv"])
+check("--actions columns", list(rows[0]), ["action", "obs_record", "episode_seed", "step", "k", "overruled",
+                                           "depth0", "depth1", "depth0_argmax"])
+check("--actions indices", [(r["action"], r["step"], r["overruled"]) for r in rows],
+      [("0", "0", "0"), ("1", "1", "1"), ("2", "2", "0"), ("3", "3", "0"), ("4", "4", "1")])
+check("--actions places", [(r["depth0_argmax"], r["depth0"], r["depth1"]) for r in rows],
+      [("target", "target", "target"), ("lookalike", "target", "target"), ("lookalike", "lookalike", "lookalike"),
+       ("target", "target", "elsewhere"), ("target", "elsewhere", "elsewhere")])
 # Voxels per side from an action's own fields, not assumed.
 check("depth-1 voxel edge", round(float(dd.voxel_edge(stream[1], 1)), 6), 0.01875)
 

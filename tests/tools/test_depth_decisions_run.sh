@@ -3,7 +3,8 @@
 # (sim-step --objects) with actions placed on the target, on a lookalike and away from both
 # gives the known table; the acting loop on two reach_prism scenes gives a table whose rows
 # add up to the actions qte-select took, whose overruled row counts the actions whose depth-0
-# voxel is not depth 0's argmax, and with K = 1 overrules nothing; a stream without objects is
+# voxel is not depth 0's argmax, and with K = 1 overrules nothing; with PICTURES every action
+# has its row, its depths' pictures and the view it was chosen on; a stream without objects is
 # refused, naming the option.
 source "$(dirname "$0")/common.sh"
 src=${QTE_SOURCE:?set QTE_SOURCE to the repository}
@@ -58,7 +59,7 @@ known,10,overruled_argmax,1,1,0,0,1.000,0.000,0.000'
 keyframe "$src/tests/data/reach_target_demo.rec" > "$tmp/transitions.rec" 2>/dev/null || fail "keyframe"
 qattn-train --steps 0 --seed 1 --checkpoint-dir "$tmp/ckpt" "$tmp/transitions.rec" 2>/dev/null || fail "qattn-train"
 for k in 3 1; do
-  AGENT="$tmp/agent$k.rec" timeout 300 bash "$src/examples/depth_decisions.sh" reach_prism "$tmp/ckpt/latest.rec" $k 32x32 2 \
+  PICTURES=$([ $k = 3 ] && echo "$tmp/pictures") AGENT="$tmp/agent$k.rec" timeout 300 bash "$src/examples/depth_decisions.sh" reach_prism "$tmp/ckpt/latest.rec" $k 32x32 2 \
     > "$tmp/k$k.csv" 2> "$tmp/k$k.err" || fail "depth_decisions.sh with K = $k: exit $?: $(cat "$tmp/k$k.err")"
   $py - "$tmp/agent$k.rec" "$tmp/k$k.csv" $k <<'EOF' || fail "the table with K = $k does not add up"
 import csv, sys
@@ -90,6 +91,25 @@ if problems:
     sys.exit("; ".join(problems))
 EOF
 done
+# PICTURES: a row per action, and for each its depths' pictures and the view it was chosen on.
+$py - "$tmp/agent3.rec" "$tmp/pictures" <<'EOF' || fail "the pictures of the decisions"
+import csv, os, sys
+import qte_stream
+records = list(qte_stream.read_records(sys.argv[1]))
+actions = [r for r in records if r.type == "action"]
+rows = list(csv.DictReader(open(os.path.join(sys.argv[2], "actions.csv"))))
+problems = [] if len(rows) == len(actions) else [f"{len(rows)} rows for {len(actions)} actions"]
+for r in rows:
+    obs = records[int(r["obs_record"])]
+    if obs.type != "obs" or str(obs.fields["step"]) != r["step"] or str(obs.fields["episode_seed"]) != r["episode_seed"]:
+        problems.append(f"action {r['action']}: record {r['obs_record']} is not its observation")
+    for name in [f"attention/{int(r['action']):06d}.depth0.png", f"attention/{int(r['action']):06d}.depth1.png",
+                 f"frames/{int(r['obs_record']):06d}.front.rgb.png"]:
+        if not os.path.isfile(os.path.join(sys.argv[2], name)):
+            problems.append(f"no {name}")
+if problems:
+    sys.exit("; ".join(problems[:5]))
+EOF
 
 # --- depths_of_runs.sh: a finished run's settings decide the replay ----------------------------
 # A run of label qte-k3-t3 whose demonstrations had a 32x32 camera and whose evaluations had 2
