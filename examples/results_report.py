@@ -27,7 +27,7 @@ TITLES = {
     "takeaway2-depths3": "Takeaway 2 at 3 depths (0.6 cm voxels, 1,000 pretraining steps; our variation, not published)",
     "takeaway2-depths3-pretrain100":
         "Takeaway 2 at 3 depths with takeaway 2's 100 pretraining steps (superseded: the finest depth breaks)",
-    "takeaway2-long": "Takeaway 2's `lift_numbered_block` with ten times the experience (2 depths)",
+    "takeaway2-long": "Takeaway 2's `lift_numbered_block` with 12.5 times the environment steps (5,000, 2 depths)",
     "takeaway3": "Takeaway 3: ablations on `reach_prism`",
     "takeaway4": "Takeaway 4: the real-world task in simulation (`reach_prism`, 1,200 processor seconds)",
     "takeaway4-unpaced": "Takeaway 4 without pacing (the earlier protocol, superseded)",
