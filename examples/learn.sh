@@ -92,6 +92,12 @@ processor="${model:-$(uname -m)} (family $(cpu_field 'cpu family') model $(cpu_f
 if [ "$ROLE" != actor ] && [ "$(tail -n1 "$run/machine" 2>/dev/null | cut -d, -f2-)" != "$processor" ]; then
   echo "$(date -u +%FT%TZ),$processor" >> "$run/machine"
 fi
+# The toolkit built (its --version's commit), a line (started_utc,commit) likewise when a start
+# finds another: a run resumed with another build says so.
+build=$(qattn-train --version | sed -n 's/.*, commit //p')
+if [ "$ROLE" != actor ] && [ "$(tail -n1 "$run/builds" 2>/dev/null | cut -d, -f2-)" != "$build" ]; then
+  echo "$(date -u +%FT%TZ),$build" >> "$run/builds"
+fi
 # The script's own waiting costs no process (it is counted in the budget, and a method that
 # takes longer would pay more for it): a read with a timeout on a FIFO nobody writes.
 [ -p "$run/actors/.tick" ] || mkfifo "$run/actors/.tick"

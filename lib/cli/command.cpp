@@ -13,6 +13,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "cli/build_commit.hpp"
 #include "common/error.hpp"
 #include "common/number_list.hpp"
 
@@ -34,7 +35,7 @@ std::vector<OptionSpec> common_options(const Usage& usage) {
        "0"},
       {"help", "", "print this help and exit", ""},
       {"help-man", "", "print this help as a man page (roff) and exit", ""},
-      {"version", "", "print the toolkit version and exit", ""},
+      {"version", "", "print the toolkit version and the commit it was built from, and exit", ""},
   };
 }
 
@@ -409,7 +410,7 @@ int run_tool(int argc, char** argv, const Usage& usage,
       return 0;
     }
     if (args.has("version")) {
-      std::cout << usage.name << " (QTE toolkit) " << QTE_VERSION << "\n";
+      std::cout << usage.name << " (QTE toolkit) " << QTE_VERSION << ", commit " << build_commit() << "\n";
       return 0;
     }
     run(args);
