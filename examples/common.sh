@@ -5,6 +5,16 @@
 # Debian's Python, with NumPy and matplotlib (debian-packages.txt); PYTHON=... for another.
 : "${PYTHON:=/usr/bin/python3}"
 
+# The K a run of METHOD acts with and expands in its target, "ACT_K TARGET_K": C2F-ARM acts
+# greedily with the double-DQN target, adaptive K chooses per node, QTE (qte) expands K in both.
+method_k() {  # METHOD K
+  case $1 in
+    c2farm) echo "1 0" ;;
+    adaptive) echo "auto auto" ;;
+    *) echo "$2 $2" ;;
+  esac
+}
+
 # The label of a run of METHOD (qte, c2farm, adaptive) expanding ACT_K when acting and TARGET_K
 # in the target, or with adaptive K its K_MARGIN and K_MAX: the run's directory and CSV names
 # and eval.csv's label column. qte-k10-t10, c2farm-k1-t0, adaptive-m0.02-max10.

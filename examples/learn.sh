@@ -56,12 +56,8 @@
 set -euo pipefail
 task=$1 run=$2
 source "$(dirname "$0")/common.sh"
-# METHOD's K, as examples/Makefile sets them: C2F-ARM acts greedily and takes double DQN targets.
-case ${METHOD:-qte} in
-  c2farm) : "${ACT_K:=1}" "${TARGET_K:=0}" ;;
-  adaptive) : "${ACT_K:=auto}" "${TARGET_K:=auto}" ;;
-esac
-: "${SEED:=0}" "${DEMOS:=10}" "${VARIATION:=0}" "${IMAGE:=128x128}" "${ACT_K:=10}" "${TARGET_K:=10}"
+read -r method_act_k method_target_k <<< "$(method_k "${METHOD:-qte}" 10)"  # METHOD's K by default
+: "${SEED:=0}" "${DEMOS:=10}" "${VARIATION:=0}" "${IMAGE:=128x128}" "${ACT_K:=$method_act_k}" "${TARGET_K:=$method_target_k}"
 : "${ENV_STEPS:=2000}" "${CHUNK_EPISODES:=10}" "${EVAL_EVERY:=250}" "${EVAL_EPISODES:=50}" "${EVAL_SEED:=1000000}"
 : "${ARCH:=light}" "${BATCH:=32}" "${RATIO:=0.5}" "${PRETRAIN:=200}" "${START_AFTER:=0}"
 : "${LEARNER_THREADS:=1}" "${EPSILON:=0.1}" "${ROTATION_NOISE:=1}" "${CHECKPOINT_EVERY:=25}"
