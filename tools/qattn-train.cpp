@@ -60,7 +60,8 @@ static cli::Usage usage() {
       "loss, mean and max Q per depth, mean TD error, steps per second); a progress line "
       "goes to standard error. A non-finite loss stops the run with the step and the "
       "records of the batch; the last checkpoint stays the last good one. Transitions of "
-      "another voxel size or depth count are refused with their position.",
+      "another voxel size, depth count or grid edge (keyframed with another --offset or "
+      "scene) are refused with their position.",
       "Architectures: 'light' (default; plain 3x3x3 convolutions, 16 base channels, about 0.25 "
       "M parameters per depth, 0.09 GMAC per sample) and 'arm' (the published inception U-Net, "
       "64 base channels, 0.88 M / 1.19 M parameters, 1.8 GMAC per sample: 20 times the work "

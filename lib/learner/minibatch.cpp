@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <map>
+#include <sstream>
 #include <utility>
 
 #include "qattention/proprio.hpp"
@@ -11,6 +12,12 @@ namespace qte::learner {
 namespace {
 
 std::string depth_field(int depth, const char* what) { return "depth" + std::to_string(depth) + "." + what; }
+
+std::string format_metres(double metres) {
+  std::ostringstream text;
+  text << metres;
+  return text.str();
+}
 
 }  // namespace
 
@@ -27,7 +34,15 @@ void check_transition(const stream::Record& t, const LearnerConfig& config) {
     for (int axis = 0; axis < 3; ++axis)
       if (index[axis] < 0 || index[axis] >= v)
         t.fail(depth_field(d, "index"), "voxel indices in 0.." + std::to_string(v - 1) + " (--voxels " + std::to_string(v) + ")");
-    voxels::bounds_field(t, depth_field(d, "bounds"), v);
+    // The next states' grids are cut with the learner's own edges: a transition keyframed with
+    // another --offset (or scene) would be learned from grids of two sizes.
+    const double edge = voxels::bounds_field(t, depth_field(d, "bounds"), v).size_m;
+    const double expected = d == 0 ? config.hierarchy.scene.size_m : 2 * config.hierarchy.offset_at(d);
+    if (std::abs(edge - expected) > 1e-6)
+      t.fail(depth_field(d, "bounds"), "a grid edge of " + format_metres(expected) + " m, as the learner's " +
+                                           (d == 0 ? std::string("scene (--bounds)") : "--offset (2 x offset)") +
+                                           "; the transition has " + format_metres(edge) +
+                                           " m (keyframed with other settings?)");
   }
   if (t.has(depth_field(depths, "index")))
     t.fail(depth_field(depths, "index"), "no more than the networks' " + std::to_string(depths) + " depths (--depths)");

@@ -115,13 +115,18 @@ cmp -s "$tmp/fa/latest.rec" "$tmp/fl/latest.rec" \
   || fail "a killed and resumed --follow run differs from one that had every chunk: $(state "$tmp/fa/latest.rec") vs" \
           "$(state "$tmp/fl/latest.rec"); $(grep resumed "$tmp/fl2.log"); $(cmp "$tmp/fa/latest.rec" "$tmp/fl/latest.rec")"
 
-# Bad input: other settings, another grid, non-finite loss, missing file, too few transitions.
+# Bad input: other settings, another grid or offset, non-finite loss, missing file, too few transitions.
 err=$(train --steps 6 --architecture arm --base-channels 8 --checkpoint-dir "$tmp/a" --resume "$tmp/tr.rec" 2>&1) \
   && fail "another architecture resumed"
 grep -q "trained with other settings.*\"architecture\": \"light\"" <<<"$err" || fail "$err"
 keyframe --voxels 8 --seed 1 "$tmp/demos.rec" > "$tmp/tr8.rec" 2>/dev/null
 err=$(train --steps 2 --checkpoint-dir "$tmp/v" "$tmp/tr8.rec" 2>&1) && fail "8-voxel transitions accepted"
 grep -q "tr8.rec: record [0-9]* at byte [0-9]*: 'transition' record, field 'voxels': expected 16 voxels" <<<"$err" || fail "$err"
+# Keyframed with another --offset: the learner's next-state grids would have other edges.
+keyframe --offset 0.1 --seed 1 "$tmp/demos.rec" > "$tmp/tr01.rec" 2>/dev/null
+err=$(train --steps 2 --checkpoint-dir "$tmp/o" "$tmp/tr01.rec" 2>&1) && fail "transitions of --offset 0.1 accepted"
+grep -q "tr01.rec: record [0-9]* at byte [0-9]*: 'transition' record, field 'depth1.bounds': expected a grid edge of 0.3 m, as the learner's --offset (2 x offset); the transition has 0.2 m" \
+  <<<"$err" || fail "$err"
 # A fresh run that stops before it saved a trained checkpoint leaves nothing behind (its
 # initial checkpoint and metrics file are removed); one that saved trained checkpoints keeps them.
 [ ! -e "$tmp/v" ] || fail "a run refused on bad input left $(ls -A "$tmp/v") behind"
