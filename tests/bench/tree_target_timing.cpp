@@ -5,7 +5,9 @@
 // them alike. Per setting: the median seconds of one target computation (the next states'
 // voxelization included), the mean grids expanded per node at depth 1, and the mean absolute
 // difference of the depth-0 target from K = 10's (every sample bootstrapping, terminal or
-// not). bench_adaptive_k runs it after the acting figures, on the same checkpoint.
+// not); then what each setting's targets are worth on average, per depth and for the last
+// depth's rotation and gripper heads (does a deeper tree pull the finest depth's targets down?).
+// bench_adaptive_k runs it after the acting figures, on the same checkpoint.
 //
 // Usage: tree_target_timing CHECKPOINT REPLAY [BATCHES [THREADS]]   (defaults 10 batches of 32, 2 threads)
 #include <algorithm>
@@ -37,11 +39,18 @@ struct Setting {
   qattention::Branching branching;
   std::vector<double> seconds, branches;
   double target_difference = 0;
+  std::vector<double> mean_targets;  // per depth, then rotation (all axes) and gripper
 };
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0 : v[v.size() / 2];
+}
+
+double mean_of(const std::vector<float>& v) {
+  double sum = 0;
+  for (float x : v) sum += x;
+  return v.empty() ? 0 : sum / static_cast<double>(v.size());
 }
 
 double mean(const std::vector<double>& v) {
@@ -86,12 +95,12 @@ int main(int argc, char** argv) try {
               replay_path.c_str(), replay.size(), batches, config.batch, threads);
 
   std::vector<Setting> settings;
-  settings.push_back({"K = 10", 10, qattention::Branching(10), {}, {}});
-  settings.push_back({"K = 1", 1, qattention::Branching(1), {}, {}});
-  settings.push_back({"double DQN", 0, qattention::Branching(1), {}, {}});
+  settings.push_back({"K = 10", 10, qattention::Branching(10), {}, {}, 0, {}});
+  settings.push_back({"K = 1", 1, qattention::Branching(1), {}, {}, 0, {}});
+  settings.push_back({"double DQN", 0, qattention::Branching(1), {}, {}, 0, {}});
   for (float margin : {0.01f, 0.02f, 0.05f})
     settings.push_back({"margin " + std::to_string(margin).substr(0, 4), 10,
-                        qattention::Branching::within_margin(margin, 10), {}, {}});
+                        qattention::Branching::within_margin(margin, 10), {}, {}, 0, {}});
 
   for (int b = 0; b <= batches; ++b) {  // batch 0 warms up
     std::mt19937_64 rng(b);
@@ -110,6 +119,11 @@ int main(int argc, char** argv) try {
       s.seconds.push_back(seconds);
       s.branches.push_back(targets.mean_branches.empty() ? 1.0 : targets.mean_branches[0]);
       if (reference.empty()) reference = targets.translation[0];  // K = 10 comes first
+      const std::size_t depths = targets.translation.size();
+      s.mean_targets.resize(depths + 2, 0.0);
+      for (std::size_t d = 0; d < depths; ++d) s.mean_targets[d] += mean_of(targets.translation[d]) / batches;
+      s.mean_targets[depths] += mean_of(targets.rotation) / batches;
+      s.mean_targets[depths + 1] += mean_of(targets.gripper) / batches;
       for (std::size_t i = 0; i < reference.size(); ++i)
         s.target_difference += std::fabs(targets.translation[0][i] - reference[i]) / (reference.size() * batches);
     }
@@ -119,6 +133,12 @@ int main(int argc, char** argv) try {
   for (const Setting& s : settings)
     std::printf("%-12s %12.3f %10.2f %12.2f %22.4f\n", s.name.c_str(), median(s.seconds), median(s.seconds) / k10,
                 mean(s.branches), s.target_difference);
+  std::printf("\nmean target %s\n", "(per depth, then the last depth's rotation and gripper heads)");
+  for (const Setting& s : settings) {
+    std::printf("%-12s", s.name.c_str());
+    for (double m : s.mean_targets) std::printf(" %9.4f", m);
+    std::printf("\n");
+  }
   return 0;
 } catch (const std::exception& e) {
   std::fprintf(stderr, "tree_target_timing: %s\n", e.what());
