@@ -37,7 +37,7 @@ void check_transition(const stream::Record& t, const LearnerConfig& config) {
     // The next states' grids are cut with the learner's own edges: a transition keyframed with
     // another --offset (or scene) would be learned from grids of two sizes.
     const double edge = voxels::bounds_field(t, depth_field(d, "bounds"), v).size_m;
-    const double expected = d == 0 ? config.hierarchy.scene.size_m : 2 * config.hierarchy.offset_at(d);
+    const double expected = config.hierarchy.bounds_at(d, Eigen::Vector3d::Zero()).size_m;
     if (std::abs(edge - expected) > 1e-6)
       t.fail(depth_field(d, "bounds"), "a grid edge of " + format_metres(expected) + " m, as the learner's " +
                                            (d == 0 ? std::string("scene (--bounds)") : "--offset (2 x offset)") +

@@ -47,15 +47,10 @@ double median(std::vector<double> v) {
   return v.empty() ? 0 : v[v.size() / 2];
 }
 
-double mean_of(const std::vector<float>& v) {
+template <typename T>
+double mean(const std::vector<T>& v) {
   double sum = 0;
-  for (float x : v) sum += x;
-  return v.empty() ? 0 : sum / static_cast<double>(v.size());
-}
-
-double mean(const std::vector<double>& v) {
-  double sum = 0;
-  for (double x : v) sum += x;
+  for (T x : v) sum += x;
   return v.empty() ? 0 : sum / static_cast<double>(v.size());
 }
 
@@ -121,9 +116,9 @@ int main(int argc, char** argv) try {
       if (reference.empty()) reference = targets.translation[0];  // K = 10 comes first
       const std::size_t depths = targets.translation.size();
       s.mean_targets.resize(depths + 2, 0.0);
-      for (std::size_t d = 0; d < depths; ++d) s.mean_targets[d] += mean_of(targets.translation[d]) / batches;
-      s.mean_targets[depths] += mean_of(targets.rotation) / batches;
-      s.mean_targets[depths + 1] += mean_of(targets.gripper) / batches;
+      for (std::size_t d = 0; d < depths; ++d) s.mean_targets[d] += mean(targets.translation[d]) / batches;
+      s.mean_targets[depths] += mean(targets.rotation) / batches;
+      s.mean_targets[depths + 1] += mean(targets.gripper) / batches;
       for (std::size_t i = 0; i < reference.size(); ++i)
         s.target_difference += std::fabs(targets.translation[0][i] - reference[i]) / (reference.size() * batches);
     }
