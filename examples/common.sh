@@ -35,9 +35,12 @@ acting_k_of_label() {  # LABEL
 # run_image (its demonstrations' camera), run_episodes (its evaluations') and
 # run_plan_options (learn.sh's PLAN_OPTIONS). Returns 1 for a run not finished; exits the
 # script for a finished run whose settings cannot be read.
+# learn.sh writes eval.csv after the final evaluation's snapshot; a run resumed past its end
+# snapshots again, leaving a checkpoint newer than its eval.csv: not finished.
 finished_run_settings() {  # RUN
   local run=${1%/}
   [ -f "$run/eval.csv" ] && [ -f "$run/eval/checkpoint.rec" ] || return 1
+  [ "$run/eval/checkpoint.rec" -nt "$run/eval.csv" ] && return 1
   run_name=$(basename "$run") run_task=$(basename "$(dirname "$run")")
   run_label=${run_name%-seed*} run_seed=${run_name##*-seed}
   read -r -a run_k <<< "$(acting_k_of_label "$run_label")"

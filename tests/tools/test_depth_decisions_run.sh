@@ -114,7 +114,8 @@ EOF
 # --- depths_of_runs.sh: a finished run's settings decide the replay ----------------------------
 # A run of label qte-k3-t3 whose demonstrations had a 32x32 camera and whose evaluations had 2
 # episodes: its table is depth_decisions.sh's with K = 3, 32x32 and 2 episodes; a run not
-# finished (no final checkpoint) gets none, and a table already there is kept.
+# finished (no final checkpoint, or one newer than its eval.csv) gets none, and a table already
+# there is kept.
 run=$tmp/runs/reach_prism/qte-k3-t3-seed4
 mkdir -p "$run/eval" "$tmp/runs/reach_prism/qte-k3-t3-seed5"
 cp "$src/tests/data/reach_target_demo.rec" "$run/demos.rec"
@@ -129,6 +130,13 @@ timeout 300 bash "$src/examples/depths_of_runs.sh" "$tmp/runs" "$tmp/depths" 2> 
 [ "$(ls "$tmp/depths")" = reach_prism_qte-k3-t3-seed4.csv ] || fail "depths_of_runs.sh wrote $(ls "$tmp/depths")"
 cmp -s "$tmp/direct.csv" "$tmp/depths/reach_prism_qte-k3-t3-seed4.csv" \
   || fail "depths_of_runs.sh's table is not the run's: $(cat "$tmp/depths/reach_prism_qte-k3-t3-seed4.csv")"
+# A run resumed past its end (learn.sh with a larger budget) snapshots a newer checkpoint than
+# its eval.csv: not finished until it writes eval.csv again, so no table.
+cp -r "$run" "$tmp/runs/reach_prism/qte-k3-t3-seed7"
+touch -d '+1 second' "$tmp/runs/reach_prism/qte-k3-t3-seed7/eval/checkpoint.rec"
+bash "$src/examples/depths_of_runs.sh" "$tmp/runs" "$tmp/depths" 2>/dev/null || fail "depths_of_runs.sh with a resumed run"
+[ "$(ls "$tmp/depths")" = reach_prism_qte-k3-t3-seed4.csv ] || fail "a resumed run got a table: $(ls "$tmp/depths")"
+rm -r "$tmp/runs/reach_prism/qte-k3-t3-seed7"
 echo kept > "$tmp/depths/reach_prism_qte-k3-t3-seed4.csv"
 bash "$src/examples/depths_of_runs.sh" "$tmp/runs" "$tmp/depths" 2>/dev/null \
   && [ "$(cat "$tmp/depths/reach_prism_qte-k3-t3-seed4.csv")" = kept ] || fail "a table already there was not kept"
