@@ -26,8 +26,11 @@ three shares (empty when a row has no actions).
 --actions OUT.csv: one row per judged action, to find a decision worth looking at: action (its
 index among the stream's actions, the n of qte-select --png's <n>.depth<d>.png), obs_record
 (the index of its observation in the stream, stream-png's <record index>.front.rgb.png),
-episode_seed, step, k, overruled (1 when the chosen depth-0 voxel is not depth 0's argmax) and
-the place of each row depth<d> and depth0_argmax. Run with Debian's python3."""
+episode_seed, step, k, overruled (1 when the chosen depth-0 voxel is not depth 0's argmax),
+held (what the gripper held when the action was chosen: target, distractor, other, or empty),
+the action's gripper_open and pose_z (its height, m), and the place of each row depth<d> and
+depth0_argmax: an episode's rows in order tell what the agent did once it held the object.
+Run with Debian's python3."""
 import argparse
 import collections
 import csv
@@ -39,6 +42,7 @@ import numpy as np
 sys.path.insert(0, __file__.rsplit("/", 2)[0] + "/lib/python")  # or installed: make install
 from qte_stream import read_records  # noqa: E402
 from ambiguity import object_at, task_objects  # noqa: E402  (one rule for where an action went)
+from failure_reasons import held_role  # noqa: E402  (one rule for what the gripper holds)
 
 PLACES = ["target", "lookalike", "elsewhere"]
 
@@ -70,7 +74,7 @@ def place(found, point, edge):
     return {"target": "target", "distractor": "lookalike"}.get(on.role if on else None, "elsewhere")
 
 
-Decision = collections.namedtuple("Decision", "k rows action obs_record episode_seed step")
+Decision = collections.namedtuple("Decision", "k rows action obs_record episode_seed step held gripper_open pose_z")
 
 
 def decisions(records, step=None):
@@ -102,7 +106,8 @@ def decisions(records, step=None):
                 rows["overruled"] = rows["depth0"]
                 rows["overruled_argmax"] = rows["depth0_argmax"]
         out.append(Decision(int(scalar(r, "k", 1)), rows, n_actions - 1, obs.index,
-                            int(scalar(obs, "episode_seed", -1)), obs_step))
+                            int(scalar(obs, "episode_seed", -1)), obs_step, held_role(obs) or "empty",
+                            int(scalar(r, "gripper_open", 1)), float(np.asarray(r.fields["pose"]).reshape(-1)[2])))
     return out
 
 
@@ -116,10 +121,11 @@ def write_actions(taken, path):
     names = depth_rows(taken)
     with open(path + ".tmp", "w", newline="") as f:
         out = csv.writer(f, lineterminator="\n")
-        out.writerow(["action", "obs_record", "episode_seed", "step", "k", "overruled"] + names)
+        out.writerow(["action", "obs_record", "episode_seed", "step", "k", "overruled", "held", "gripper_open",
+                      "pose_z"] + names)
         for t in taken:
-            out.writerow([t.action, t.obs_record, t.episode_seed, t.step, t.k, int("overruled" in t.rows)]
-                         + [t.rows.get(name, "") for name in names])
+            out.writerow([t.action, t.obs_record, t.episode_seed, t.step, t.k, int("overruled" in t.rows), t.held,
+                          t.gripper_open, f"{t.pose_z:.4f}"] + [t.rows.get(name, "") for name in names])
     os.replace(path + ".tmp", path)  # whole or not at all
 
 

@@ -34,9 +34,10 @@ def yaw_pose(xyz, yaw):
     return list(xyz) + [0, 0, math.sin(yaw / 2), math.cos(yaw / 2)]
 
 
-def obs(step=0):
-    """An observation with the three objects as sim-step --objects writes them."""
-    return Record("obs", {
+def obs(step=0, held=None):
+    """An observation with the three objects as sim-step --objects writes them; `held`, the
+    objects.held flags (none: a stream written before that field)."""
+    return Record("obs", ({} if held is None else {"objects.held": np.array(held, np.uint8)}) | {
         "objects.names": "block1,block2,success_zone",
         "objects.role": np.array([1, 2, 0], np.uint8),
         "objects.pose": np.array([yaw_pose(TARGET, 0), yaw_pose(LOOKALIKE, math.pi / 4), yaw_pose(ZONE, 0)]),
@@ -77,11 +78,12 @@ check("between two close objects, nearer the lookalike", dd.place(near_both, TAR
 check("between two close objects, nearer the target", dd.place(near_both, TARGET + [0.03, 0, 0], coarse), "target")
 
 
-def action(points, argmax_point=None, k=10, explored=0):
+def action(points, argmax_point=None, k=10, explored=0, gripper_open=1):
     """An action of qte-select whose voxel at depth d holds points[d]: depth 0 over the 1 m scene,
-    depth 1 the 30 cm around depth 0's voxel centre, 16 voxels per side."""
-    fields, bounds = {"k": np.array(k, np.int32), "explored": np.array(explored, np.uint8)}, \
-        np.array([-0.3, -0.5, 0.6, 1.0])
+    depth 1 the 30 cm around depth 0's voxel centre, 16 voxels per side; its pose at the last point."""
+    fields, bounds = {"k": np.array(k, np.int32), "explored": np.array(explored, np.uint8),
+                      "pose": np.array(list(points[-1]) + [1, 0, 0, 0.0]),
+                      "gripper_open": np.array(gripper_open, np.uint8)}, np.array([-0.3, -0.5, 0.6, 1.0])
     for d, p in enumerate(points):
         edge = bounds[3] / 16
         index = np.floor((p - bounds[:3]) / edge).astype(np.int32)
@@ -98,7 +100,7 @@ away = TARGET + np.array([0.0, 0.2, 0.0]) + [0.1, 0, 0]  # 20 cm from both
 stream = [obs(0), action([TARGET, TARGET]),                       # both depths on the target
           obs(1), action([TARGET, TARGET], argmax_point=LOOKALIKE),  # depth 0's argmax on the lookalike, overruled
           obs(2), action([LOOKALIKE, LOOKALIKE]),                 # both on the lookalike
-          obs(3), action([TARGET, TARGET + [0.04, 0, 0]]),        # depth 1 beside the target
+          obs(3, held=[1, 0, 0]), action([TARGET, TARGET + [0.04, 0, 0]], gripper_open=0),  # holding the target
           obs(4), action([away, away], argmax_point=TARGET),      # overruled, to nowhere
           obs(5), action([LOOKALIKE, LOOKALIKE], explored=1)]     # explored: left out
 taken = dd.decisions(stream)
@@ -118,8 +120,14 @@ with tempfile.TemporaryDirectory() as tmp:
     with open(os.path.join(tmp, "actions.csv")) as f:
         rows = list(csv.DictReader(f))
     check("--actions files", os.listdir(tmp), ["actions.csv"])
-check("--actions columns", list(rows[0]), ["action", "obs_record", "episode_seed", "step", "k", "overruled",
-                                           "depth0", "depth1", "depth0_argmax"])
+check("--actions columns", list(rows[0]), ["action", "obs_record", "episode_seed", "step", "k", "overruled", "held",
+                                           "gripper_open", "pose_z", "depth0", "depth1", "depth0_argmax"])
+# What the gripper held when each action was chosen (the observation's objects.held; an older
+# stream's closed, stopped fingers otherwise: open here, so empty), and the action's gripper
+# and height.
+check("--actions held", [(r["held"], r["gripper_open"], r["pose_z"]) for r in rows],
+      [("empty", "1", f"{TARGET[2]:.4f}"), ("empty", "1", f"{TARGET[2]:.4f}"), ("empty", "1", f"{LOOKALIKE[2]:.4f}"),
+       ("target", "0", f"{TARGET[2]:.4f}"), ("empty", "1", f"{away[2]:.4f}")])
 check("--actions indices", [(r["action"], r["step"], r["overruled"]) for r in rows],
       [("0", "0", "0"), ("1", "1", "1"), ("2", "2", "0"), ("3", "3", "0"), ("4", "4", "1")])
 check("--actions places", [(r["depth0_argmax"], r["depth0"], r["depth1"]) for r in rows],
