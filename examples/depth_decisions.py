@@ -68,6 +68,11 @@ def centre_of(action, d, index):
     return bounds[:3] + (np.asarray(index, np.float64) + 0.5) * voxel_edge(action, d)
 
 
+def pose_z(action):
+    """The action's height (m), None for an action written without its pose."""
+    return float(np.asarray(action.fields["pose"]).reshape(-1)[2]) if "pose" in action.fields else None
+
+
 def place(found, point, edge):
     """Where a voxel centre lies: 'target', 'lookalike' or 'elsewhere'."""
     on = object_at(found, point, edge / 2)
@@ -107,7 +112,7 @@ def decisions(records, step=None):
                 rows["overruled_argmax"] = rows["depth0_argmax"]
         out.append(Decision(int(scalar(r, "k", 1)), rows, n_actions - 1, obs.index,
                             int(scalar(obs, "episode_seed", -1)), obs_step, held_role(obs) or "empty",
-                            int(scalar(r, "gripper_open", 1)), float(np.asarray(r.fields["pose"]).reshape(-1)[2])))
+                            int(scalar(r, "gripper_open", 1)), pose_z(r)))
     return out
 
 
@@ -125,7 +130,7 @@ def write_actions(taken, path):
                       "pose_z"] + names)
         for t in taken:
             out.writerow([t.action, t.obs_record, t.episode_seed, t.step, t.k, int("overruled" in t.rows), t.held,
-                          t.gripper_open, f"{t.pose_z:.4f}"] + [t.rows.get(name, "") for name in names])
+                          t.gripper_open, "" if t.pose_z is None else f"{t.pose_z:.4f}"] + [t.rows.get(name, "") for name in names])
     os.replace(path + ".tmp", path)  # whole or not at all
 
 
