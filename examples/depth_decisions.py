@@ -129,8 +129,9 @@ def write_actions(taken, path):
         out.writerow(["action", "obs_record", "episode_seed", "step", "k", "overruled", "held", "gripper_open",
                       "pose_z"] + names)
         for t in taken:
+            z = "" if t.pose_z is None else f"{t.pose_z:.4f}"
             out.writerow([t.action, t.obs_record, t.episode_seed, t.step, t.k, int("overruled" in t.rows), t.held,
-                          t.gripper_open, "" if t.pose_z is None else f"{t.pose_z:.4f}"] + [t.rows.get(name, "") for name in names])
+                          t.gripper_open, z] + [t.rows.get(name, "") for name in names])
     os.replace(path + ".tmp", path)  # whole or not at all
 
 

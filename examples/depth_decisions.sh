@@ -7,8 +7,8 @@
 #        (0), EVAL_SEED (1000000) and PLAN_OPTIONS as there, as failure_reasons.sh replays them. DECISION_STEP=N:
 #        only the decisions at step N of each episode (0: the first). AGENT=FILE keeps the
 #        episodes' records there. PICTURES=DIR: to look at the decisions, DIR/actions.csv (a row
-#        per action: where each depth's voxel lies, whether depth 0 was overruled; see
-#        depth_decisions.py --actions), DIR/attention/<action>.depth<d>.png (qte-select --png:
+#        per action: where each depth's voxel lies, whether depth 0 was overruled, what the
+#        gripper held; see depth_decisions.py --actions), DIR/attention/<action>.depth<d>.png (qte-select --png:
 #        each depth's Q values, the chosen voxel outlined) and DIR/frames/<obs_record>.*.rgb.png
 #        (the cameras' view the action was chosen on).
 set -euo pipefail
