@@ -64,7 +64,7 @@ read -r method_act_k method_target_k <<< "$(method_k "${METHOD:-qte}" 10)"  # ME
 : "${N_STEP:=1}" "${ACTORS:=1}" "${CPU_BUDGET:=0}" "${K_MARGIN:=0.02}" "${K_MAX:=10}" "${ROLE:=all}" "${ACTOR_INDEX:=0}"
 : "${ALSO_ACT_K:=}" "${METHOD:=qte}" "${LABEL:=$(run_label "$METHOD" "$ACT_K" "$TARGET_K" "$K_MARGIN" "$K_MAX")}"
 : "${STAGE:=sim-step --image-size $IMAGE}" "${DEMOS_FROM:=}" "${TIME_BUDGET:=0}" "${NET_OPTIONS:=}"
-: "${PLAN_OPTIONS:=}" "${EVAL_STAGE:=$STAGE}"
+: "${PLAN_OPTIONS:=}" "${EVAL_STAGE:=$STAGE}" "${ACCOUNT_EVERY:=30}"
 export PLAN_OPTIONS  # failure_reasons.sh plans the final agent's moves the same way
 eval "stage=($STAGE)"
 eval "eval_stage=($EVAL_STAGE)"
@@ -98,7 +98,7 @@ fi
 # takes longer would pay more for it): a read with a timeout on a FIFO nobody writes.
 [ -p "$run/actors/.tick" ] || mkfifo "$run/actors/.tick"
 exec {tick}<> "$run/actors/.tick"
-nap() { read -r -t "$1" -u "$tick" _ || true; }
+nap() { read -r -t "$1" -u "$tick" _ || true; keep_accounts; }
 # Adaptive K (ACT_K or TARGET_K 'auto'): each node expands the voxels within K_MARGIN of its
 # best Q, at most K_MAX; the options go only to the programs whose K is 'auto'.
 branching() {  # K -> the options that go with it
@@ -108,10 +108,12 @@ act_branching=$(branching "$ACT_K") target_branching=$(branching "$TARGET_K")
 log() { printf '%s %s\n' "$(date +%H:%M:%S)" "$*" >&2; }
 # Processor time of the run, split by role, summed over resumptions (evaluations and the failure
 # analysis excluded), in ticks in cpu_ticks ("demos pretrain learner actor other"): demos,
-# the demonstrations; pretrain and learner, the learner process before and after its first
-# checkpoint; actor, the actor pipelines; other, this script and the programs it calls.
-# train_s: wall-clock seconds up to each evaluation (evaluations excluded).
-clock=$(date +%s) ticks=$(getconf CLK_TCK) learner=
+# the demonstrations; pretrain and learner, the learner process before and after step
+# PRETRAIN; actor, the actor pipelines; other, this script and the programs it calls.
+# train_s: wall-clock seconds up to each evaluation (evaluations excluded). Both are saved
+# before each evaluation and every ACCOUNT_EVERY seconds while the run waits, so a run killed
+# and resumed loses at most that much of either (and a processor budget stays a budget).
+clock=$(date +%s) ticks=$(getconf CLK_TCK) learner= pretraining=0 saved_accounts=$EPOCHSECONDS
 cpu_base=(0 0 0 0 0)
 [ ! -f "$run/cpu_ticks" ] || read -r -a cpu_base < "$run/cpu_ticks"
 demos_ticks=0 eval_ticks=0 pretrain_ticks=0 reaped_actor_ticks=0
@@ -132,15 +134,16 @@ tree_ticks() {  # PID: its processor ticks and those of its live descendants (wi
 }
 shell_ticks() { stat_ticks $$ 14 15 16 17; }  # this script and every child it has reaped
 cpu_roles() {  # -> ticks of "demos pretrain learner actor other", this run so far
-  local learner_now i actors=$reaped_actor_ticks reaped=$reaped_actor_ticks
+  local learner_now pretrain i actors=$reaped_actor_ticks reaped=$reaped_actor_ticks
   learner_now=$(stat_ticks "$learner" 14 15)
+  pretrain=$(( pretraining ? learner_now : pretrain_ticks ))  # the learner's ticks up to step PRETRAIN
   for i in "${!actor_pids[@]}"; do  # an actor that has ended is in shell_ticks with its last reading
     if kill -0 "${actor_pids[$i]}" 2>/dev/null; then actor_ticks[$i]=$(tree_ticks "${actor_pids[$i]}")
     else reaped=$(( reaped + ${actor_ticks[$i]:-0} )); fi
     actors=$(( actors + ${actor_ticks[$i]:-0} ))
   done
-  echo $(( cpu_base[0] + demos_ticks )) $(( cpu_base[1] + pretrain_ticks )) \
-    $(( cpu_base[2] + learner_now - pretrain_ticks )) $(( cpu_base[3] + actors )) \
+  echo $(( cpu_base[0] + demos_ticks )) $(( cpu_base[1] + pretrain )) \
+    $(( cpu_base[2] + learner_now - pretrain )) $(( cpu_base[3] + actors )) \
     $(( cpu_base[4] + $(shell_ticks) - eval_ticks - demos_ticks - reaped ))
 }
 cpu_seconds() { cpu_roles | awk -v t="$ticks" '{ print int(($1 + $2 + $3 + $4 + $5) / t) }'; }
@@ -150,7 +153,13 @@ count_training_time() {
   mv "$run/train_seconds.tmp" "$run/train_seconds"
   cpu_roles > "$run/cpu_ticks.tmp"
   mv "$run/cpu_ticks.tmp" "$run/cpu_ticks"
-  clock=$now
+  clock=$now saved_accounts=$EPOCHSECONDS
+}
+# From the waits (nap): the times so far, every ACCOUNT_EVERY seconds. A split run's actor
+# keeps none (the learner's side keeps the run's).
+keep_accounts() {
+  [ "$ROLE" != actor ] && [ $(( EPOCHSECONDS - saved_accounts )) -ge "$ACCOUNT_EVERY" ] || return 0
+  count_training_time
 }
 # The CSV columns of the processor time: cpu_s, then cpu_<role>_s.
 cpu_columns() {

@@ -3,13 +3,14 @@
 # run has taken follow from its environment steps and the replay ratio, whatever the machine's
 # load), one actor pipeline (one qte-select, one LibTorch start) serves the whole run, the CSV
 # splits the processor time by role, and a learner that dies stops the run at once with a line
-# naming it; the run then resumes to its end.
+# naming it; the run then resumes to its end, its processor and wall-clock accounts kept across
+# the kill (saved while it waits, ACCOUNT_EVERY seconds apart, not only before evaluations).
 source "$(dirname "$0")/common.sh"
 learn=${QTE_SOURCE:?}/examples/learn.sh
 run=$tmp/run
 # A learner 3 steps per agent transition: without pacing, the actor runs ahead of it.
 export SEED=0 DEMOS=2 IMAGE=48x48 ACT_K=1 TARGET_K=0 ENV_STEPS=1000000 CHUNK_EPISODES=2 EVAL_EVERY=1000000 \
-  EVAL_EPISODES=1 BATCH=4 PRETRAIN=2 RATIO=3 CHECKPOINT_EVERY=1 START_AFTER=0 CPU_BUDGET=1000000
+  EVAL_EPISODES=1 BATCH=4 PRETRAIN=2 RATIO=3 CHECKPOINT_EVERY=1 START_AFTER=0 CPU_BUDGET=1000000 ACCOUNT_EVERY=1
 
 # 0. learn.sh's pacing counts the steps allowed as qattn-train does.
 eval "$(sed -n '/^steps_allowed() {/p' "$learn")"
@@ -40,6 +41,12 @@ grep -q "the learner (qattn-train, pid $learner) died, killed by signal KILL; la
 [ "$(sort -u <<<"${actors[*]// /$'\n'}" | grep -c .)" = 1 ] || fail "qte-select processes: ${actors[*]}"
 sleep 1
 pgrep -f "$run" > /dev/null && fail "programs of the run still running: $(pgrep -af "$run")"
+# The accounts were saved while the chunks ran (the only evaluation came before them): the
+# actors' processor time and the wall-clock of the first chunk survive the kill.
+[ "$run/cpu_ticks" -nt "$run/actors/gate-0/0000.steps" ] && [ "$run/train_seconds" -nt "$run/actors/gate-0/0000.steps" ] \
+  || fail "the accounts were last saved before the first chunk ended: $(ls -l --time-style=full-iso "$run" "$run/actors/gate-0")"
+read -r -a saved < "$run/cpu_ticks"
+[ "${saved[3]}" -gt 0 ] || fail "no actor time in the saved accounts: ${saved[*]}"
 
 # 2. Resume with a budget this run has nearly spent: it ends by itself, with an evaluation. The
 # replay first gets a torn last record, as an append killed half-way leaves: it is cut off.
