@@ -113,7 +113,7 @@ log() { printf '%s %s\n' "$(date +%H:%M:%S)" "$*" >&2; }
 # train_s: wall-clock seconds up to each evaluation (evaluations excluded). Both are saved
 # before each evaluation and every ACCOUNT_EVERY seconds while the run waits, so a run killed
 # and resumed loses at most that much of either (and a processor budget stays a budget).
-clock=$(date +%s) ticks=$(getconf CLK_TCK) learner= pretraining=0 saved_accounts=$EPOCHSECONDS
+clock=$(date +%s) ticks=$(getconf CLK_TCK) learner= pretraining=0
 cpu_base=(0 0 0 0 0)
 [ ! -f "$run/cpu_ticks" ] || read -r -a cpu_base < "$run/cpu_ticks"
 demos_ticks=0 eval_ticks=0 pretrain_ticks=0 reaped_actor_ticks=0
@@ -153,12 +153,12 @@ count_training_time() {
   mv "$run/train_seconds.tmp" "$run/train_seconds"
   cpu_roles > "$run/cpu_ticks.tmp"
   mv "$run/cpu_ticks.tmp" "$run/cpu_ticks"
-  clock=$now saved_accounts=$EPOCHSECONDS
+  clock=$now
 }
-# From the waits (nap): the times so far, every ACCOUNT_EVERY seconds. A split run's actor
-# keeps none (the learner's side keeps the run's).
+# From the waits (nap): the times so far, ACCOUNT_EVERY seconds after they were last counted
+# (clock). A split run's actor keeps none (the learner's side keeps the run's).
 keep_accounts() {
-  [ "$ROLE" != actor ] && [ $(( EPOCHSECONDS - saved_accounts )) -ge "$ACCOUNT_EVERY" ] || return 0
+  [ "$ROLE" != actor ] && [ $(( EPOCHSECONDS - clock )) -ge "$ACCOUNT_EVERY" ] || return 0
   count_training_time
 }
 # The CSV columns of the processor time: cpu_s, then cpu_<role>_s.
