@@ -147,9 +147,11 @@ cpu_roles() {  # -> ticks of "demos pretrain learner actor other", this run so f
     $(( cpu_base[4] + $(shell_ticks) - eval_ticks - demos_ticks - reaped ))
 }
 cpu_seconds() { cpu_roles | awk -v t="$ticks" '{ print int(($1 + $2 + $3 + $4 + $5) / t) }'; }
+# train_s at time $1: what train_seconds holds plus the seconds since it was last counted.
+train_seconds_at() { echo $(( $(cat "$run/train_seconds" 2>/dev/null || echo 0) + $1 - clock )); }
 count_training_time() {
   local now; now=$(date +%s)
-  echo $(( $(cat "$run/train_seconds" 2>/dev/null || echo 0) + now - clock )) > "$run/train_seconds.tmp"
+  train_seconds_at "$now" > "$run/train_seconds.tmp"
   mv "$run/train_seconds.tmp" "$run/train_seconds"
   cpu_roles > "$run/cpu_ticks.tmp"
   mv "$run/cpu_ticks.tmp" "$run/cpu_ticks"
@@ -173,7 +175,7 @@ cpu_columns() {
 # chunk starts, and the final evaluation takes the learner's newest checkpoint as it stands.
 out_of_budget() {
   { [ "$CPU_BUDGET" -gt 0 ] && [ "$(cpu_seconds)" -ge "$CPU_BUDGET" ]; } ||
-    { [ "$TIME_BUDGET" -gt 0 ] && [ $(( $(cat "$run/train_seconds" 2>/dev/null || echo 0) + $(date +%s) - clock )) -ge "$TIME_BUDGET" ]; }
+    { [ "$TIME_BUDGET" -gt 0 ] && [ "$(train_seconds_at "$(date +%s)")" -ge "$TIME_BUDGET" ]; }
 }
 budgeted() { [ "$CPU_BUDGET" -gt 0 ] || [ "$TIME_BUDGET" -gt 0 ]; }
 
