@@ -44,6 +44,8 @@
 #
 # NET_OPTIONS: the coarse-to-fine hierarchy when not the published one, for keyframe and the
 # learner alike (e.g. "--depths 3 --offset 0.15,0.05"; qte-select takes it from the checkpoint).
+# PRECISION: the networks' arithmetic, qattn-train's and qte-select's --precision (auto, fp32 or
+# bf16); the builds file records what the learner ran in.
 # PLAN_OPTIONS: plan-path's options for the agent's moves, in training and in every evaluation
 # (e.g. "--approach 0.1": grasps end in a straight descent along the tool axis; plan-path(1)).
 #
@@ -64,7 +66,7 @@ read -r method_act_k method_target_k <<< "$(method_k "${METHOD:-qte}" 10)"  # ME
 : "${N_STEP:=1}" "${ACTORS:=1}" "${CPU_BUDGET:=0}" "${K_MARGIN:=0.02}" "${K_MAX:=10}" "${ROLE:=all}" "${ACTOR_INDEX:=0}"
 : "${ALSO_ACT_K:=}" "${METHOD:=qte}" "${LABEL:=$(run_label "$METHOD" "$ACT_K" "$TARGET_K" "$K_MARGIN" "$K_MAX")}"
 : "${STAGE:=sim-step --image-size $IMAGE}" "${DEMOS_FROM:=}" "${TIME_BUDGET:=0}" "${NET_OPTIONS:=}"
-: "${PLAN_OPTIONS:=}" "${EVAL_STAGE:=$STAGE}" "${ACCOUNT_EVERY:=30}"
+: "${PLAN_OPTIONS:=}" "${EVAL_STAGE:=$STAGE}" "${ACCOUNT_EVERY:=30}" "${PRECISION:=auto}"
 export PLAN_OPTIONS  # failure_reasons.sh plans the final agent's moves the same way
 eval "stage=($STAGE)"
 eval "eval_stage=($EVAL_STAGE)"
@@ -88,9 +90,11 @@ processor="${model:-$(uname -m)} (family $(cpu_field 'cpu family') model $(cpu_f
 if [ "$ROLE" != actor ] && [ "$(tail -n1 "$run/machine" 2>/dev/null | cut -d, -f2-)" != "$processor" ]; then
   echo "$(date -u +%FT%TZ),$processor" >> "$run/machine"
 fi
-# The toolkit built (its --version's commit), a line (started_utc,commit) likewise when a start
-# finds another: a run resumed with another build says so.
-build=$(qattn-train --version | sed -n 's/.*, commit //p')
+# The toolkit built (its --version's commit) and the precision its networks run in here, a line
+# (started_utc,commit,precision) likewise when a start finds another: a run resumed with another
+# build or precision says so.
+build=$(qattn-train --version | sed -n 's/.*, commit //p'),$(qattn-train --architecture "$ARCH" $NET_OPTIONS \
+  --batch "$BATCH" --precision "$PRECISION" --print-precision | cut -d' ' -f1)
 if [ "$ROLE" != actor ] && [ "$(tail -n1 "$run/builds" 2>/dev/null | cut -d, -f2-)" != "$build" ]; then
   echo "$(date -u +%FT%TZ),$build" >> "$run/builds"
 fi
@@ -238,7 +242,7 @@ start_actor() {  # ACTOR: its pipeline, in the background, from its first chunk 
       "${stage[@]}" --task "$task" --variation "$VARIATION" --episodes 10000000 --seed $(( SEED * 100000 )) --scenes explore \
         --chunk-episodes "$CHUNK_EPISODES" --first-chunk "$(next_chunk "$i")" --chunk-stride "$ACTORS" --gate "$gate" --compress \
       qte-select --checkpoint "$run/ckpt/latest.rec" --reload --k "$ACT_K" $act_branching --epsilon "$EPSILON" \
-        --rotation-noise "$ROTATION_NOISE" --seed $(( SEED * 100000 + i )) --threads 1 \
+        --rotation-noise "$ROTATION_NOISE" --seed $(( SEED * 100000 + i )) --threads 1 --precision "$PRECISION" \
       plan-path $PLAN_OPTIONS \
       '|' keyframe --agent --seed "$SEED" $NET_OPTIONS --append --output "$actor_replay"
     echo "${agent_loop_status[*]}" > "$run/actors/status-$i"
@@ -338,6 +342,7 @@ pretraining=$(( $(newest_checkpoint_step "$run/ckpt") < PRETRAIN ))
 qattn-train --follow --resume --stop-file "$run/actor.done" --replay-ratio "$RATIO" --pretrain "$PRETRAIN" \
   --start-after "$START_AFTER" --steps 1000000 --checkpoint-every "$CHECKPOINT_EVERY" --keep 4 \
   --architecture "$ARCH" $NET_OPTIONS --batch "$BATCH" --tree-target "$TARGET_K" $target_branching --n-step "$N_STEP" --seed "$SEED" --threads "$LEARNER_THREADS" \
+  --precision "$PRECISION" \
   --checkpoint-dir "$run/ckpt" --metrics "$run/train.csv" "${inputs[@]}" 2>> "$run/train.log" &
 learner=$!
 trap 'kill_tree $(jobs -p)' EXIT  # the learner and the actors, with every program they started
@@ -367,7 +372,7 @@ evaluate() {  # CHECKPOINT ENV_STEPS OUT.csv LEARNER_STEP EVAL_POINT
   local fifo; fifo=$(mktemp -u)
   agent_loop "$fifo" \
     "${eval_stage[@]}" --task "$task" --variation "$VARIATION" --episodes "$EVAL_EPISODES" --seed "$EVAL_SEED" --scenes eval \
-    qte-select --checkpoint "$1" --k "$ACT_K" $act_branching --threads 1 \
+    qte-select --checkpoint "$1" --k "$ACT_K" $act_branching --threads 1 --precision "$PRECISION" \
     plan-path $PLAN_OPTIONS \
     '|' episode-stats --label "$LABEL" --column seed="$SEED" --column env_steps="$2" --column train_step="$4" \
       --column eval_point="$5" --column train_s="$(cat "$run/train_seconds")" $(cpu_columns) \

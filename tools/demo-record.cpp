@@ -4,6 +4,7 @@
 #include "cli/command.hpp"
 #include "demos/demo_recorder.hpp"
 #include "planning/planner_options.hpp"
+#include "robot/robot_model.hpp"
 #include "sim_step/simulator_options.hpp"
 #include "stream/writer.hpp"
 #include "tasks/task.hpp"
@@ -40,6 +41,7 @@ static cli::Usage usage() {
        "demonstrations of every variation at the resolution of the coarse-ambiguity tasks"},
   };
   u.see_also = {"sim-step(1)", "plan-path(1)", "keyframe(1)", "qte-stream(5)"};
+  u.environment = robot::kDataDirEnvironment;
   return u;
 }
 

@@ -4,6 +4,7 @@
 #include "camera_recordings/camera_options.hpp"
 #include "camera_recordings/recording.hpp"
 #include "cli/command.hpp"
+#include "robot/robot_model.hpp"
 #include "stream/stream_options.hpp"
 #include "stream/writer.hpp"
 
@@ -87,6 +88,7 @@ static cli::Usage usage() {
        "voxelize saved clouds and look at the grids"},
   };
   u.see_also = {"sim-step(1)", "voxelize(1)", "qte-select(1)", "plan-path(1)", "keyframe(1)", "qte-stream(5)"};
+  u.environment = robot::kDataDirEnvironment;
   return u;
 }
 

@@ -3,6 +3,7 @@
 #include "planning/motion_planner.hpp"
 #include "planning/planner_options.hpp"
 #include "point_clouds/cloud_filters.hpp"
+#include "robot/robot_model.hpp"
 #include "stream/reader.hpp"
 #include "stream/stage.hpp"
 #include "stream/writer.hpp"
@@ -53,6 +54,7 @@ static cli::Usage usage() {
        "re-plan a saved episode and look at the map"},
   };
   u.see_also = {"sim-step(1)", "demo-record(1)", "qte-stream(5)", "octovis(1)"};
+  u.environment = robot::kDataDirEnvironment;
   return u;
 }
 

@@ -67,7 +67,8 @@ static cli::Usage usage() {
       "64 base channels, 0.88 M / 1.19 M parameters, 1.8 GMAC per sample: 20 times the work "
       "per step on a CPU).",
   };
-  // FILE and --checkpoint-dir are needed for training, not for the --steps-allowed query.
+  // FILE and --checkpoint-dir are needed for training, not for the --steps-allowed and
+  // --print-precision queries.
   u.arguments = {{"FILE", "frame and transition records; '-' is standard input (at least one)", true, true}};
   u.options = {
       {"checkpoint-dir", "DIR", "where checkpoints go (required)", ""},
@@ -75,6 +76,9 @@ static cli::Usage usage() {
       {"steps-allowed", "N", "print the gradient steps --follow allows after N agent transitions (with --pretrain and "
                              "--replay-ratio) and exit: the pacing rule, for scripts that wait on the learner", ""},
       {"keep", "N", "numbered checkpoints to keep", "3"},
+      nets::precision_option(),
+      {"print-precision", "", "print what the networks run in here with these options (fp32 or bf16, then why "
+                               "fp32 where bf16 was asked for) and exit; the progress lines end with it too", ""},
   };
   u.add_options(learner::loop_options());
   u.add_options(learner::learner_config_options());
@@ -95,9 +99,14 @@ static cli::Usage usage() {
 
 static void run(const cli::Arguments& args) {
   const learner::LearnerConfig config = learner::learner_config_from(args);
-  const learner::LoopOptions loop = learner::loop_options_from(args);
+  learner::LoopOptions loop = learner::loop_options_from(args);
   if (args.has("steps-allowed")) {
     std::cout << learner::allowed_steps(loop, args.integer("steps-allowed", 0, INT64_MAX)) << "\n";
+    return;
+  }
+  if (args.flag("print-precision")) {
+    nets::use_precision_option(args);
+    std::cout << nets::precision_in_use(config.net, config.hierarchy.voxels(), config.batch) << "\n";
     return;
   }
   if (!args.has("checkpoint-dir")) throw UsageError("--checkpoint-dir is required");
@@ -105,6 +114,9 @@ static void run(const cli::Arguments& args) {
   const replay::ReplayOptions replay_options = learner::replay_options_from(args);
 
   nets::set_torch_threads(loop.threads);
+  nets::use_precision_option(args);
+  const std::string in_use = nets::precision_in_use(config.net, config.hierarchy.voxels(), config.batch);
+  loop.networks_in = in_use.substr(0, in_use.find(' '));
   nets::seed_torch(loop.seed);
   learner::QLearner learner(config);
   replay::ReplayBuffer replay(replay_options);

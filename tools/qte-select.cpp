@@ -87,6 +87,7 @@ static cli::Usage usage() {
       {"ignore-collisions", "", "set ignore_collisions in every action (straight-line moves)", ""},
       {"reload", "", "at the start of each episode, load the checkpoint again when the file changed", ""},
       nets::torch_threads_option(2),
+      nets::precision_option(),
       {"png", "DIR", "save the Q-values of every depth's grid as DIR/<n>.depth<d>.png (all at the end of the input, or none)", ""},
   };
   u.options.push_back(cli::output_file());
@@ -152,6 +153,7 @@ static void run(const cli::Arguments& args) {
   options.prepare = point_clouds::observation_filter(point_clouds::parse_cloud_filters(args));
 
   nets::set_torch_threads(static_cast<int>(args.integer("threads", 1, 256)));
+  nets::use_precision_option(args);
   qattention::CheckpointNetworks networks(checkpoint);
   options.hierarchy = voxels::checkpoint_hierarchy(args, networks.hierarchy(), networks.config().net.voxels,
                                                    networks.config().depths, checkpoint);

@@ -8,6 +8,7 @@
 #include "camera_recordings/camera_options.hpp"
 #include "cli/command.hpp"
 #include "common/atomic_file.hpp"
+#include "robot/robot_model.hpp"
 #include "robot_step/robot_world.hpp"
 #include "sim_step/simulator_options.hpp"
 #include "tasks/task.hpp"
@@ -85,6 +86,7 @@ static cli::Usage usage() {
        "check what would be sent, the camera live, the arm still"},
   };
   u.see_also = {"sim-step(1)", "xarm-export(1)", "obs-pack(1)", "plan-path(1)", "qte-stream(5)"};
+  u.environment = robot::kDataDirEnvironment;
   return u;
 }
 

@@ -1,5 +1,6 @@
 // sim-step: the simulator as a filter: reset and trajectory records in, observations out.
 #include "cli/command.hpp"
+#include "robot/robot_model.hpp"
 #include "sim_step/simulator.hpp"
 #include "sim_step/simulator_options.hpp"
 #include "tasks/task.hpp"
@@ -56,6 +57,7 @@ static cli::Usage usage() {
        "one explicit reset, 256x256 images"},
   };
   u.see_also = {"qte-stream(5)", "plan-path(1)", "stream-png(1)", "stream-dump(1)"};
+  u.environment = robot::kDataDirEnvironment;
   return u;
 }
 

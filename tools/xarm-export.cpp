@@ -4,8 +4,9 @@
 #include <iostream>
 
 #include "cli/command.hpp"
-#include "common/indexed_name.hpp"
 #include "common/atomic_file.hpp"
+#include "common/indexed_name.hpp"
+#include "robot/robot_model.hpp"
 #include "robot/xarm_export.hpp"
 #include "stream/reader.hpp"
 
@@ -45,6 +46,7 @@ static cli::Usage usage() {
       {"python3 examples/xarm_play.py --ip 192.168.1.185 moves/000004.xarm.csv", "play one move on the robot"},
   };
   u.see_also = {"plan-path(1)", "sim-step(1)", "qte-stream(5)"};
+  u.environment = robot::kDataDirEnvironment;
   return u;
 }
 

@@ -332,6 +332,7 @@ std::string help_text(const Usage& usage) {
     out += "\nExamples:\n";
     for (const auto& e : usage.examples) out += "  " + e.command + "\n" + wrap(e.explanation, 6);
   }
+  if (!usage.environment.empty()) out += "\nEnvironment:\n" + wrap(usage.environment, 2);
   out += "\nExit status:\n" + wrap(kCommonExitStatus, 2);
   if (!usage.exit_status.empty()) out += wrap(usage.exit_status, 2);
   if (!usage.see_also.empty()) {
@@ -366,6 +367,7 @@ std::string man_page(const Usage& usage) {
     for (const auto& e : usage.examples)
       out += ".PP\n.nf\n" + roff(e.command) + "\n.fi\n.RS\n" + roff(e.explanation) + "\n.RE\n";
   }
+  if (!usage.environment.empty()) out += ".SH ENVIRONMENT\n" + roff(usage.environment) + "\n";
   out += ".SH EXIT STATUS\n" + roff(kCommonExitStatus) + "\n";
   if (!usage.exit_status.empty()) out += ".PP\n" + roff(usage.exit_status) + "\n";
   if (!usage.see_also.empty()) {

@@ -59,6 +59,7 @@ struct Usage {
   // True when the tool draws random numbers; --seed is accepted by every tool either way.
   bool uses_randomness = false;
   std::string exit_status;  // extra text for EXIT STATUS; the common codes are always listed
+  std::string environment;  // the environment variables it reads, for ENVIRONMENT (none: no section)
 
   // Appends an option group shared by several tools (e.g. voxels::hierarchy_options()).
   void add_options(const std::vector<OptionSpec>& group) { options.insert(options.end(), group.begin(), group.end()); }

@@ -105,6 +105,10 @@ std::vector<cli::OptionSpec> replay_options() {
       {"uniform", "", "uniform replay sampling instead of prioritised", ""},
       {"alpha", "A", "priority exponent", default_text(d.alpha)},
       {"capacity", "N", "replay capacity in transitions (demos always kept)", default_text(d.capacity)},
+      {"cloud-memory", "MIB",
+       "memory for the replay's point clouds, each computed once when its frame is first sampled (about 1 MiB a "
+       "frame of 4 cameras at 128x128); frames beyond it have theirs computed at every use",
+       default_text(d.cloud_memory_bytes >> 20)},
   };
 }
 
@@ -113,6 +117,7 @@ replay::ReplayOptions replay_options_from(const cli::Arguments& args) {
   options.capacity = static_cast<std::size_t>(args.integer("capacity", 1, 1000000000));
   options.prioritised = !args.flag("uniform");
   options.alpha = args.real("alpha", 0, 10);
+  options.cloud_memory_bytes = static_cast<std::size_t>(args.integer("cloud-memory", 0, int64_t{1} << 30)) << 20;
   return options;
 }
 

@@ -26,7 +26,7 @@ LearnerConfig learner_config_from(const cli::Arguments& args);
 std::vector<cli::OptionSpec> loop_options();
 LoopOptions loop_options_from(const cli::Arguments& args);
 
-// --uniform, --alpha, --capacity.
+// --uniform, --alpha, --capacity, --cloud-memory.
 std::vector<cli::OptionSpec> replay_options();
 replay::ReplayOptions replay_options_from(const cli::Arguments& args);
 

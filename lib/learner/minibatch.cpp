@@ -1,5 +1,6 @@
 #include "learner/minibatch.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -69,13 +70,15 @@ Minibatch assemble_minibatch(const replay::ReplayBuffer& replay, const replay::S
     const std::size_t index = sample.indices[i];
     const stream::Record& t = replay.transition(index);  // checked when read (check_transition)
     const stream::Record& frame = replay.frame_of(index);
-    const voxels::ObservationCloud cloud = voxels::observation_cloud(frame);
-    voxels::require_points_in_scene(frame, cloud, h.scene);  // never learn from an empty scene
+    auto start = std::chrono::steady_clock::now();
+    const auto cloud = replay.cloud_of(index);
+    b.clouds_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    voxels::require_points_in_scene(frame, *cloud, h.scene);  // never learn from an empty scene
     for (int d = 0; d < depths; ++d) {
       const voxels::GridBounds g = voxels::bounds_field(t, depth_field(d, "bounds"), v);
       const auto index3 = t.array<int32_t>(depth_field(d, "index"));
       b.voxel[d][i] = voxels::flat_index(Eigen::Vector3i(index3[0], index3[1], index3[2]), v);
-      voxels::voxelize(cloud.view(), g, b.grids[d].data() + i * grid_floats);
+      voxels::voxelize(cloud->view(), g, b.grids[d].data() + i * grid_floats);
     }
     const std::vector<float> p = qattention::proprio_of(frame, t.scalar<int32_t>("step"));
     b.proprio.insert(b.proprio.end(), p.begin(), p.end());
@@ -103,8 +106,10 @@ Minibatch assemble_minibatch(const replay::ReplayBuffer& replay, const replay::S
     b.discount.push_back(static_cast<float>(discount));
     const stream::Record& next = replay.next_frame_of(last);
     const int32_t next_step = replay.transition(last).scalar<int32_t>("step") + 1;
-    b.next_clouds.push_back(voxels::observation_cloud(next));
-    voxels::require_points_in_scene(next, b.next_clouds.back(), h.scene);
+    start = std::chrono::steady_clock::now();
+    b.next_clouds.push_back(replay.next_cloud_of(last));
+    b.clouds_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    voxels::require_points_in_scene(next, *b.next_clouds.back(), h.scene);
     b.next_proprio.push_back(qattention::proprio_of(next, next_step));
     b.next_state.push_back(next_states.emplace(std::pair{&next, next_step}, next_states.size()).first->second);
   }

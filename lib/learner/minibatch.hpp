@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "learner/settings.hpp"
@@ -22,13 +23,14 @@ struct Minibatch {
   std::vector<int64_t> gripper;             // [B]: 1 = open (the gripper head's index)
   std::vector<float> reward;                // as stored (100 on success); the discounted sum over n steps
   std::vector<float> discount;              // gamma^n, or 0 when the chain ends within n steps
-  std::vector<voxels::ObservationCloud> next_clouds;
+  std::vector<std::shared_ptr<const voxels::ObservationCloud>> next_clouds;  // the replay's kept clouds
   std::vector<std::vector<float>> next_proprio;
   // Which samples reach the same next state (the same stored frame at the same step): equal
   // ids, so their bootstrap values are computed once. Empty: every sample its own state.
   std::vector<int64_t> next_state;
   std::vector<double> weights;              // importance weights
   std::vector<std::size_t> indices;         // replay indices
+  double clouds_s = 0;  // wall time spent getting the point clouds (the benchmarks' table)
 };
 
 // Voxelizes the sampled transitions' frames. The transitions must have passed

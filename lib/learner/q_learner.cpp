@@ -1,5 +1,6 @@
 #include "learner/q_learner.hpp"
 
+#include <chrono>
 #include <cmath>
 
 #include "common/error.hpp"
@@ -15,6 +16,9 @@ namespace {
 torch::Tensor floats(std::vector<float> values, std::vector<int64_t> shape) {
   return torch::from_blob(values.data(), shape, torch::kFloat32).clone();
 }
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
 torch::Tensor longs(const std::vector<int64_t>& values, std::vector<int64_t> shape) {
   return torch::from_blob(const_cast<int64_t*>(values.data()), shape, torch::kInt64).clone();
 }
@@ -54,6 +58,7 @@ Targets QLearner::targets(const Minibatch& batch) const {
 
 StepStats QLearner::train_step(const Minibatch& batch) {
   StepStats stats = gradients(batch);
+  const auto start = Clock::now();
   torch_->adam->step();
   {  // target <- tau * online + (1 - tau) * target
     torch::NoGradGuard no_grad;
@@ -64,13 +69,17 @@ StepStats QLearner::train_step(const Minibatch& batch) {
     }
   }
   ++step_;
+  stats.optimiser_s = seconds_since(start);
   return stats;
 }
 
 StepStats QLearner::gradients(const Minibatch& batch) {
   const voxels::CoarseToFine& h = config_.hierarchy;
   const int depths = h.depths, v = h.voxels(), n = batch.size, p = config_.net.proprio;
+  auto start = Clock::now();
   const Targets targets = this->targets(batch);
+  const double targets_s = seconds_since(start);
+  start = Clock::now();
   const auto weights = torch::tensor(std::vector<float>(batch.weights.begin(), batch.weights.end()));
   const auto proprio = floats(batch.proprio, {n, p});
   const auto huber = [&](const torch::Tensor& q, const torch::Tensor& y) {
@@ -111,6 +120,9 @@ StepStats QLearner::gradients(const Minibatch& batch) {
   if (!std::isfinite(stats.loss)) throw Error("non-finite loss (" + std::to_string(stats.loss) + ")");
   stats.td_errors = td;
   stats.mean_branches = targets.mean_branches;
+  stats.targets_s = targets_s;
+  stats.forward_s = seconds_since(start);
+  start = Clock::now();
 
   torch_->adam->zero_grad();
   total.backward();
@@ -119,6 +131,7 @@ StepStats QLearner::gradients(const Minibatch& batch) {
     if (config_.grad_clip_norm > 0) torch::nn::utils::clip_grad_norm_(parameters, config_.grad_clip_norm);
     if (config_.grad_clip_value > 0) torch::nn::utils::clip_grad_value_(parameters, config_.grad_clip_value);
   }
+  stats.backward_s = seconds_since(start);
   return stats;
 }
 

@@ -26,7 +26,7 @@ NextStates next_states(const Minibatch& batch) {
     const int64_t id = batch.next_state.empty() ? -1 - i : batch.next_state[i];
     const auto [at, added] = seen.emplace(id, static_cast<int>(states.clouds.size()));
     if (added) {
-      states.clouds.push_back(batch.next_clouds[i].view());
+      states.clouds.push_back(batch.next_clouds[i]->view());
       states.proprios.push_back(batch.next_proprio[i]);
     }
     states.of_sample.push_back(at->second);

@@ -261,7 +261,7 @@ void TrainingLoop::log_row(const StepStats& stats) {
             << stats.loss << "  q_max";
   for (double q : stats.q_max) progress_ << ' ' << std::setprecision(3) << q;
   progress_ << "  replay " << replay_.size() << " (" << replay_.demo_count() << " demos)  " << std::setprecision(3)
-            << rate << " steps/s\n";
+            << rate << " steps/s  " << options_.networks_in << "\n";
   window_start_ = now;
   window_steps_ = 0;
   td_sum_ = priority_sum_ = 0;

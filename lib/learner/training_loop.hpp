@@ -36,6 +36,7 @@ struct LoopOptions {
   std::string metrics_path;      // CSV; empty: none
   uint64_t seed = 0;
   int threads = 2;  // LibTorch's: floating-point sums differ with it, so a resume must keep it
+  std::string networks_in = "fp32";  // what the networks' convolutions run in, for the progress lines
   std::chrono::milliseconds poll{200};
 };
 

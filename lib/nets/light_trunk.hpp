@@ -13,6 +13,7 @@
 
 #include <torch/torch.h>
 
+#include <string>
 #include <vector>
 
 namespace qte::nets {
@@ -31,6 +32,35 @@ std::vector<torch::Tensor> light_trunk(const torch::Tensor& grid, const torch::T
 // run time); LightNet uses LibTorch's layers otherwise.
 bool light_trunk_supported(const torch::Tensor& grid, int base_channels);
 
+// The convolutions' arithmetic. bf16: each convolution reads its input and weights rounded to
+// bf16 and accumulates in fp32 (oneDNN's kernels for AVX-512 BF16 or AMX, up to twice the fp32
+// rate); the activations between layers, pooling, upsampling, sums, every gradient outside the
+// convolutions, the parameters, Adam and the Q values stay fp32, so a checkpoint is the same
+// whichever precision trained it. Where this processor has no native bf16 kernels for a shape,
+// that trunk runs in fp32 (precision_running says which). fp32 is the default.
+enum class Precision { fp32, bf16 };
+// Whether oneDNN's effective instruction set here has AVX-512 BF16 (or AMX); ONEDNN_MAX_CPU_ISA
+// lowers it.
+bool bf16_native_here();
+// Whether bf16 convolutions are faster than fp32 ones here: where oneDNN has AMX. With AVX-512
+// BF16 alone they are not on every processor measured: an Intel Xeon (family 6 model 207) runs
+// vdpbf16ps at half the rate of its fp32 multiply-adds, and oneDNN 2.6's bf16 kernels for these
+// small-channel 3D convolutions took 1.3x the fp32 step (docs/performance.md).
+bool bf16_faster_here();
+// --precision's values: auto (bf16 where bf16_faster_here, else fp32), fp32, bf16; Error otherwise.
+Precision precision_from_name(const std::string& name);
+const char* precision_name(Precision precision);
+void use_precision(Precision precision);
+Precision precision_requested();
+// What a training trunk of that shape runs in here: fp32 unless bf16 is requested, the oneDNN
+// trunk is in use and oneDNN has native bf16 kernels for every convolution of it.
+Precision precision_running(int64_t batch, int64_t channels, int base_channels, int64_t voxels);
+
+// Whether forwards without gradients (acting, the learner's targets) run oneDNN's inference
+// primitives, which keep nothing for a backward (default on). Off, they run the training
+// primitives a forward with gradients runs; the benchmarks compare the two in one process.
+void use_inference_primitives(bool on);
+
 // Whether LightNet uses light_trunk where it can (default: onednn::layers_by_default()). Off,
 // it runs LibTorch's layers; the tests and benchmarks compare the two in one process.
 void use_onednn_trunk(bool on);
@@ -47,6 +77,7 @@ struct TrunkTime {
   double backward_data_s = 0;         // the convolutions' input gradients
   double weight_gradients_s = 0;      // the swapped convolutions and their reorders
   double layouts_s = 0;               // plain <-> blocked conversions at the trunk's ends
+  double precision_conversions_s = 0;  // bf16 roundings of the convolutions' inputs and gradients
   double other_s = 0;  // LeakyReLU backwards, pooling, upsampling, sums, bias gradients, buffers
 };
 TrunkTime light_trunk_time();

@@ -7,6 +7,7 @@
 #include <cstdlib>
 
 #include "common/error.hpp"
+#include "nets/light_trunk.hpp"
 #include "nets/qattention_modules.hpp"
 
 namespace qte::nets {
@@ -176,6 +177,26 @@ cli::OptionSpec torch_threads_option(int default_threads) {
           "the processor has AVX2 or wider; the environment variable QTE_NETWORK_LAYERS=libtorch runs LibTorch's layers "
           "instead (values equal within fp32 rounding, other bytes)",
           cli::default_text(default_threads)};
+}
+
+cli::OptionSpec precision_option() {
+  return {"precision", "P",
+          "the networks' convolutions: fp32, or bf16 (bf16 inputs and weights, fp32 sums: up to twice the fp32 rate "
+          "where the processor has AVX-512 BF16 or AMX; parameters, optimiser, Q values and checkpoints stay fp32, so "
+          "a checkpoint trained either way acts either way); auto: bf16 where the processor has it natively, fp32 "
+          "elsewhere. Only the 'light' architecture's oneDNN trunk has a bf16 path; the rest runs fp32",
+          "auto"};
+}
+
+void use_precision_option(const cli::Arguments& args) { use_precision(precision_from_name(args.text("precision"))); }
+
+std::string precision_in_use(const NetConfig& config, int voxels, int batch) {
+  const bool light = config.architecture == Architecture::light;
+  if (precision_requested() == Precision::fp32) return "fp32";
+  if (!light || !onednn_trunk_in_use()) return "fp32 (bf16 runs only in the light architecture's oneDNN trunk)";
+  return precision_running(batch, config.channels, config.base_channels, voxels) == Precision::bf16
+             ? "bf16"
+             : "fp32 (oneDNN has no native bf16 kernels for these layers on this processor)";
 }
 
 void prepare_process_for_networks(char** argv) {

@@ -112,6 +112,14 @@ void set_torch_threads(int threads);
 // --threads, the option of set_torch_threads (qte-select, qattn-train).
 cli::OptionSpec torch_threads_option(int default_threads);
 
+// --precision, the networks' arithmetic (qte-select, qattn-train): auto, fp32 or bf16
+// (nets/light_trunk.hpp). use_precision_option sets it for the process from the arguments.
+cli::OptionSpec precision_option();
+void use_precision_option(const cli::Arguments& args);
+// What the networks of `config` run in here, for a program's log: "bf16", or "fp32" with why
+// when bf16 was asked for and is not available.
+std::string precision_in_use(const NetConfig& config, int voxels, int batch);
+
 // Programs that run networks call this first thing in main(): it keeps argv for
 // set_torch_threads and keeps freed activations in the heap for the next forward (see the .cpp).
 void prepare_process_for_networks(char** argv);

@@ -6,6 +6,13 @@
 #include "common/error.hpp"
 
 namespace qte::replay {
+namespace {
+
+std::size_t cloud_size_bytes(const voxels::ObservationCloud& cloud) {
+  return cloud.xyz.size() * sizeof(float) + cloud.rgb.size() + sizeof(cloud);
+}
+
+}  // namespace
 
 ReplayBuffer::ReplayBuffer(ReplayOptions options) : options_(options), tree_(options.capacity) {
   if (options_.capacity == 0) throw Error("replay capacity must be at least 1");
@@ -63,7 +70,32 @@ bool ReplayBuffer::add(const stream::Record& record) {
 
 void ReplayBuffer::release(const FrameKey& key) {
   auto it = frames_.find(key);
-  if (it != frames_.end() && --it->second.second <= 0) frames_.erase(it);
+  if (it == frames_.end() || --it->second.second > 0) return;
+  frames_.erase(it);
+  const auto cloud = clouds_.find(key);
+  if (cloud == clouds_.end()) return;
+  cloud_bytes_ -= cloud_size_bytes(*cloud->second);
+  clouds_.erase(cloud);
+}
+
+std::shared_ptr<const voxels::ObservationCloud> ReplayBuffer::cloud_of_frame(const FrameKey& key) const {
+  const auto kept = clouds_.find(key);
+  if (kept != clouds_.end()) return kept->second;
+  auto cloud = std::make_shared<const voxels::ObservationCloud>(voxels::observation_cloud(frames_.at(key).first));
+  const std::size_t bytes = cloud_size_bytes(*cloud);
+  if (cloud_bytes_ + bytes <= options_.cloud_memory_bytes) {
+    clouds_.emplace(key, cloud);
+    cloud_bytes_ += bytes;
+  }
+  return cloud;
+}
+
+std::shared_ptr<const voxels::ObservationCloud> ReplayBuffer::cloud_of(std::size_t index) const {
+  return cloud_of_frame(transitions_.at(index).frame);
+}
+
+std::shared_ptr<const voxels::ObservationCloud> ReplayBuffer::next_cloud_of(std::size_t index) const {
+  return cloud_of_frame(transitions_.at(index).next_frame);
 }
 
 Sample ReplayBuffer::sample(std::size_t batch, double beta, std::mt19937_64& rng) const {

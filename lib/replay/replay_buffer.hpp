@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <optional>
 #include <random>
 #include <string>
@@ -13,6 +14,7 @@
 
 #include "replay/sum_tree.hpp"
 #include "stream/record.hpp"
+#include "voxels/observation_cloud.hpp"
 
 namespace qte::replay {
 
@@ -21,6 +23,10 @@ struct ReplayOptions {
   bool prioritised = true;
   double alpha = 0.7;
   double priority_epsilon = 1e-3;
+  // Memory for the frames' point clouds, each computed the first time one of its transitions is
+  // sampled and kept while the frame is in the replay; past it, a frame's cloud is computed at
+  // every use (0: none kept).
+  std::size_t cloud_memory_bytes = std::size_t{2048} << 20;
 };
 
 struct Sample {
@@ -54,6 +60,10 @@ class ReplayBuffer {
   // The observation a transition acts on, and the one it reaches.
   const stream::Record& frame_of(std::size_t index) const;
   const stream::Record& next_frame_of(std::size_t index) const;
+  // Their point clouds (voxels::observation_cloud), kept within ReplayOptions::cloud_memory_bytes.
+  std::shared_ptr<const voxels::ObservationCloud> cloud_of(std::size_t index) const;
+  std::shared_ptr<const voxels::ObservationCloud> next_cloud_of(std::size_t index) const;
+  std::size_t cloud_memory_used() const { return cloud_bytes_; }
   // The transition that continues `index`'s chain, if the replay holds one: what n-step
   // returns follow. It acts on the observation `index` reaches, one step later; chains that
   // share a frame at another step (demo augmentation starts chains at several frames) are
@@ -70,10 +80,14 @@ class ReplayBuffer {
     bool demo = false;
   };
   void release(const FrameKey& key);
+  std::shared_ptr<const voxels::ObservationCloud> cloud_of_frame(const FrameKey& key) const;
 
   ReplayOptions options_;
   std::vector<Stored> transitions_;
   std::map<FrameKey, std::pair<stream::Record, int>> frames_;  // frame and its reference count
+  // Point clouds kept so far (filled as frames are sampled: sampling is a const operation).
+  mutable std::map<FrameKey, std::shared_ptr<const voxels::ObservationCloud>> clouds_;
+  mutable std::size_t cloud_bytes_ = 0;
   std::map<ChainKey, std::size_t> acting_on_;  // the newest transition acting on each frame at each step
   SumTree tree_;
   std::size_t demos_ = 0;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -76,12 +77,30 @@ Joint joint_from(const urdf::Joint& joint, const std::string& path) {
 
 }  // namespace
 
+const char* const kDataDirEnvironment =
+    "QTE_DATA_DIR: the directory that holds xarm7.urdf, the robot description. Unset, the program looks in "
+    "share/qte beside its own directory: PREFIX/share/qte for an install (make install PREFIX=...), BUILD/share/qte "
+    "in a build tree; an install can be moved as a whole.";
+
 std::string default_data_dir() {
-  if (const char* env = std::getenv("QTE_DATA_DIR")) return env;
-  for (const std::string& dir : {std::string(QTE_SOURCE_DATA_DIR), std::string(QTE_INSTALLED_DATA_DIR)})
-    if (!dir.empty() && file_exists(dir + "/xarm7.urdf")) return dir;
-  throw Error("cannot find the robot description xarm7.urdf: set QTE_DATA_DIR to the directory "
-              "that holds it");
+  if (const char* env = std::getenv("QTE_DATA_DIR")) {
+    if (!file_exists(std::string(env) + "/xarm7.urdf"))
+      throw Error("QTE_DATA_DIR=" + std::string(env) + " holds no xarm7.urdf (the toolkit's robot description)");
+    return env;
+  }
+  // share/qte beside the program's own directory or one or two above it: PREFIX/bin/x finds
+  // PREFIX/share/qte, BUILD/tools/x and BUILD/tests/bench/x find BUILD/share/qte.
+  std::error_code error;
+  const std::filesystem::path program = std::filesystem::read_symlink("/proc/self/exe", error);
+  std::filesystem::path dir = error ? std::filesystem::path() : program.parent_path();
+  for (int up = 0; up < 3 && !dir.empty(); ++up, dir = dir.parent_path()) {
+    const std::filesystem::path data = dir.parent_path() / "share" / "qte";
+    if (file_exists((data / "xarm7.urdf").string())) return data.string();
+    if (dir == dir.parent_path()) break;
+  }
+  throw Error("cannot find the robot description xarm7.urdf in share/qte beside " +
+              (program.empty() ? std::string("the program") : program.parent_path().string()) +
+              " (an install puts it in PREFIX/share/qte): set QTE_DATA_DIR to the directory that holds it");
 }
 
 RobotModel RobotModel::xarm7() { return load_urdf(default_data_dir() + "/xarm7.urdf"); }

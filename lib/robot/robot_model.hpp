@@ -43,7 +43,8 @@ class RobotModel {
   // Parses a URDF file (liburdfdom). It must hold one chain of 7 revolute joints from the
   // root link to a link named "tcp", and prismatic finger joints (named "*finger*").
   static RobotModel load_urdf(const std::string& path);
-  // The toolkit's xArm 7: $QTE_DATA_DIR/xarm7.urdf, else the installed or source copy.
+  // The toolkit's xArm 7: $QTE_DATA_DIR/xarm7.urdf, else the copy in share/qte beside the
+  // program (PREFIX/share/qte installed, BUILD/share/qte in a build tree).
   static RobotModel xarm7();
 
   const std::vector<Link>& links() const { return links_; }
@@ -76,5 +77,7 @@ class RobotModel {
 };
 
 std::string default_data_dir();
+// What the programs that load the robot say of it in their ENVIRONMENT section.
+extern const char* const kDataDirEnvironment;
 
 }  // namespace qte::robot

@@ -1,7 +1,7 @@
 #include "voxels/voxel_grid.hpp"
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 
@@ -121,8 +121,20 @@ void accumulate(const PointCloud& cloud, const std::vector<GridBounds>& grids, f
                        static_cast<float>(b.min_corner.z())},
                       static_cast<float>(1.0 / b.voxel_size_m())});
   const float vf = static_cast<float>(v);
+  // The box around every grid: most of a scene's points lie outside a tree's finer grids, and
+  // one test skips them for all the grids at once (the sums are unchanged: the same points
+  // reach each grid in the same order). Widened by a voxel so that rounding never drops a point
+  // the per-grid test below would keep.
+  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (const auto& b : grids)
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], static_cast<float>(b.min_corner[a] - b.voxel_size_m()));
+      hi[a] = std::max(hi[a], static_cast<float>(b.min_corner[a] + b.size_m + b.voxel_size_m()));
+    }
   for (std::size_t i = 0; i < cloud.count; ++i) {
     const float* p = cloud.xyz + 3 * i;
+    if (!(p[0] >= lo[0] && p[1] >= lo[1] && p[2] >= lo[2] && p[0] <= hi[0] && p[1] <= hi[1] && p[2] <= hi[2]))
+      continue;  // outside every grid, or NaN
     const uint8_t* c = cloud.rgb + 3 * i;
     for (std::size_t g = 0; g < frames.size(); ++g) {
       const Frame& f = frames[g];

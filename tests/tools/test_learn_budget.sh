@@ -65,10 +65,12 @@ grep -q "repaired $run/replay.rec: record [0-9]* at byte $replay_bytes: cut off 
 # same processor adding none.
 awk -F, -v cores="$(nproc)" 'NF < 4 || $1 !~ /^20[0-9-]+T[0-9:]+Z$/ || $(NF - 1) !~ /^(avx512f|avx2|other)$/ || $NF != cores { bad = 1 }
   END { exit bad || NR != 1 }' "$run/machine" || fail "the run's machine record: $(cat "$run/machine")"
-# And the toolkit's commit, as qattn-train --version names it: one line likewise.
+# And the toolkit's commit, as qattn-train --version names it, and the precision its networks
+# ran in, as qattn-train --print-precision says: one line likewise.
 commit=$(qattn-train --version | sed -n 's/.*, commit //p')
-[ -n "$commit" ] && [ "$(wc -l < "$run/builds")" = 1 ] && [ "$(cut -d, -f2- "$run/builds")" = "$commit" ] \
-  && grep -Eq '^20[0-9-]+T[0-9:]+Z,' "$run/builds" || fail "the run's build record: $(cat "$run/builds")"
+precision=$(qattn-train --precision auto --print-precision | cut -d' ' -f1)
+[ -n "$commit" ] && [ "$(wc -l < "$run/builds")" = 1 ] && [ "$(cut -d, -f2- "$run/builds")" = "$commit,$precision" ] \
+  && grep -Eq '^20[0-9-]+T[0-9:]+Z,[^,]+,(fp32|bf16)$' "$run/builds" || fail "the run's build record: $(cat "$run/builds")"
 final=$(tail -1 "$run/eval.csv")
 column() { awk -F, -v name="$1" 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i } NR == 2 { print $c[name] }' \
   <(head -1 "$run/eval.csv"; echo "$final"); }

@@ -8,6 +8,7 @@
 #include "common/error.hpp"
 #include "learner/q_learner.hpp"
 #include "learner_fixtures.hpp"
+#include "nets/light_trunk.hpp"
 #include "nets/qattention_modules.hpp"
 
 using namespace qte;
@@ -64,7 +65,7 @@ TEST(QLearner, TerminalTargetsAreTheScaledRewardAndNonTerminalOnesBootstrap) {
   for (const auto& p : batch.next_proprio) proprio.insert(proprio.end(), p.begin(), p.end());
   std::vector<float> grid(static_cast<std::size_t>(V * V * V * voxels::kChannels) * batch.size);
   for (int i = 0; i < batch.size; ++i)
-    voxels::voxelize(batch.next_clouds[i].view(), config.hierarchy.scene, grid.data() + i * V * V * V * voxels::kChannels);
+    voxels::voxelize(batch.next_clouds[i]->view(), config.hierarchy.scene, grid.data() + i * V * V * V * voxels::kChannels);
   const nets::QValues online = learner.online()[0].predict(grid.data(), proprio.data(), batch.size);
   const nets::QValues target = target_nets[0].predict(grid.data(), proprio.data(), batch.size);
   for (int i = 0; i < batch.size; ++i) {
@@ -156,6 +157,66 @@ TEST(QLearner, CheckpointResumesStepForStep) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("\"architecture\": \"light\""), std::string::npos) << e.what();
   }
+  std::filesystem::remove_all(dir);
+}
+
+// A checkpoint holds fp32 parameters and Adam state whichever precision trained them: one
+// trained with bf16 convolutions resumes in fp32 bit for bit and acts there, and back. Acting in
+// bf16, the greedy voxel may differ from fp32's only where fp32 itself nearly ties: its fp32 Q
+// is within bf16's rounding of the fp32 best.
+TEST(QLearner, ACheckpointTrainedInBf16LoadsAndActsInFp32AndBack) {
+  if (!nets::bf16_native_here()) GTEST_SKIP() << "no AVX-512 BF16 or AMX here";
+  nets::set_torch_threads(2);
+  const auto dir = std::filesystem::temp_directory_path() / ("qte_learner_bf16_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  learner::LearnerConfig config = small_config();
+  replay::ReplayBuffer replay = tiny_replay(config);
+  const learner::Minibatch batch = learner::assemble_minibatch(replay, all_of(replay), config);
+  const stream::Record extra("learner");
+
+  nets::use_precision(nets::Precision::bf16);
+  nets::seed_torch(21);
+  learner::QLearner bf16(config);
+  for (int i = 0; i < 5; ++i) EXPECT_TRUE(std::isfinite(bf16.train_step(batch).loss));
+  bf16.save((dir / "bf16.rec").string(), extra);
+
+  nets::use_precision(nets::Precision::fp32);
+  nets::seed_torch(998);
+  learner::QLearner fp32(config);
+  fp32.load((dir / "bf16.rec").string());
+  EXPECT_EQ(flat_parameters(fp32.online()), flat_parameters(bf16.online()));
+  EXPECT_EQ(flat_parameters(fp32.target()), flat_parameters(bf16.target()));
+
+  // Acting: the depth-0 Q values of the batch's states in fp32 and in bf16.
+  std::vector<float> grid(static_cast<std::size_t>(V * V * V * voxels::kChannels) * batch.size);
+  for (int i = 0; i < batch.size; ++i)
+    voxels::voxelize(batch.next_clouds[i]->view(), config.hierarchy.scene, grid.data() + i * V * V * V * voxels::kChannels);
+  const nets::QValues in_fp32 = fp32.online()[0].predict(grid.data(), batch.proprio.data(), batch.size);
+  nets::use_precision(nets::Precision::bf16);
+  const nets::QValues in_bf16 = fp32.online()[0].predict(grid.data(), batch.proprio.data(), batch.size);
+  nets::use_precision(nets::Precision::fp32);
+  for (int i = 0; i < batch.size; ++i) {
+    const float* q32 = in_fp32.translation.data() + i * V * V * V;
+    const float* q16 = in_bf16.translation.data() + i * V * V * V;
+    const float best = *std::max_element(q32, q32 + V * V * V);
+    float scale = 1e-6f;
+    for (int v = 0; v < V * V * V; ++v) {
+      scale = std::max(scale, std::abs(q32[v]));
+      EXPECT_NEAR(q16[v], q32[v], 0.04 * std::max(1e-3f, std::abs(best))) << "sample " << i << " voxel " << v;
+    }
+    const int64_t chosen = std::max_element(q16, q16 + V * V * V) - q16;
+    EXPECT_GE(q32[chosen], best - 0.04f * scale) << "sample " << i << ": bf16's choice is no near-tie in fp32";
+  }
+
+  // And back: trained on in fp32, resumed in bf16 bit for bit.
+  fp32.train_step(batch);
+  fp32.save((dir / "fp32.rec").string(), extra);
+  nets::use_precision(nets::Precision::bf16);
+  learner::QLearner again(config);
+  again.load((dir / "fp32.rec").string());
+  EXPECT_EQ(flat_parameters(again.online()), flat_parameters(fp32.online()));
+  EXPECT_TRUE(std::isfinite(again.train_step(batch).loss));
+  nets::use_precision(nets::Precision::fp32);
   std::filesystem::remove_all(dir);
 }
 

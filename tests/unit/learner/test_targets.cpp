@@ -85,7 +85,7 @@ struct Case {
     for (uint32_t seed : {11u, 12u, 13u}) clouds.emplace_back(seed, std::array<uint8_t, 3>{200, 100, 50});
     batch.size = 3;
     for (int i = 0; i < 3; ++i) {
-      batch.next_clouds.push_back({clouds[i].xyz, clouds[i].rgb});
+      batch.next_clouds.push_back(std::make_shared<voxels::ObservationCloud>(voxels::ObservationCloud{clouds[i].xyz, clouds[i].rgb}));
       batch.next_proprio.push_back({1, 0.04f, 0.04f, 0.1f * i});
     }
     batch.reward = {0, 0, 100};        // the last one reaches the goal: r * 0.01 = 1 ...
@@ -109,7 +109,7 @@ TEST(BootstrapTargets, TreeExpansionRanksWithTheOnlineNetworkAndValuesWithTheTar
     const learner::Targets t = learner::bootstrap_targets(online, target, c.config, c.batch);
     bool other_than_target_ranking = false;
     for (int i = 0; i < c.batch.size; ++i) {
-      const Subtree want = reference(online, target, c.config.hierarchy, c.batch.next_clouds[i].view(),
+      const Subtree want = reference(online, target, c.config.hierarchy, c.batch.next_clouds[i]->view(),
                                      c.batch.next_proprio[i], k, 0, c.config.hierarchy.scene);
       ASSERT_EQ(want.depth_values.size(), static_cast<std::size_t>(depths));
       for (int d = 0; d < depths; ++d)
@@ -118,7 +118,7 @@ TEST(BootstrapTargets, TreeExpansionRanksWithTheOnlineNetworkAndValuesWithTheTar
         EXPECT_FLOAT_EQ(t.rotation[3 * i + axis], bootstrap(c.batch, i, want.rotation[axis]));
       EXPECT_FLOAT_EQ(t.gripper[i], bootstrap(c.batch, i, want.gripper));
       // The target network ranking and valuing alone (the earlier, overestimating target).
-      const Subtree self = reference(target, target, c.config.hierarchy, c.batch.next_clouds[i].view(),
+      const Subtree self = reference(target, target, c.config.hierarchy, c.batch.next_clouds[i]->view(),
                                      c.batch.next_proprio[i], k, 0, c.config.hierarchy.scene);
       if (std::abs(self.value - want.value) > 1e-4f) other_than_target_ranking = true;
     }
@@ -132,7 +132,7 @@ TEST(BootstrapTargets, DoubleDqnValuesEachDepthsGreedyVoxelWithTheTargetNetwork)
   Case c(2, 0);
   const learner::Targets t = learner::bootstrap_targets(online, target, c.config, c.batch);
   for (int i = 0; i < c.batch.size; ++i) {
-    const Subtree greedy = reference(online, target, c.config.hierarchy, c.batch.next_clouds[i].view(),
+    const Subtree greedy = reference(online, target, c.config.hierarchy, c.batch.next_clouds[i]->view(),
                                      c.batch.next_proprio[i], 1, 0, c.config.hierarchy.scene);
     for (int d = 0; d < 2; ++d) EXPECT_FLOAT_EQ(t.translation[d][i], bootstrap(c.batch, i, greedy.q_values[d]));
     EXPECT_FLOAT_EQ(t.gripper[i], bootstrap(c.batch, i, greedy.gripper));
@@ -146,7 +146,7 @@ TEST(BootstrapTargets, TreeTargetOneIsAlgorithmTwoWithKOne) {
   Case c(2, 1);
   const learner::Targets t = learner::bootstrap_targets(q, q, c.config, c.batch);
   std::vector<voxels::PointCloud> clouds;
-  for (const auto& cloud : c.batch.next_clouds) clouds.push_back(cloud.view());
+  for (const auto& cloud : c.batch.next_clouds) clouds.push_back(cloud->view());
   const auto algorithm2 = expand_batch(q, c.config.hierarchy, clouds, c.batch.next_proprio, 1);
   for (int i = 0; i < c.batch.size; ++i) {
     EXPECT_FLOAT_EQ(t.translation[0][i], bootstrap(c.batch, i, algorithm2[i].value));

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstring>
 #include <fstream>
 
 #include "replay/growing_stream.hpp"
@@ -29,6 +30,31 @@ stream::Record transition(int64_t episode, int32_t from, int32_t to, bool demo) 
   t.set_scalar<int32_t>("next_frame", to);
   t.set_scalar<uint8_t>("demo", demo);
   return t;
+}
+
+// A frame seen by one depth camera (the replay's compact form: millimetres), looking down at a
+// plane whose depth varies with the pixel, so that every point differs.
+stream::Record depth_frame(int64_t episode, int32_t index) {
+  constexpr int kWidth = 24, kHeight = 16;
+  stream::Record f = frame(episode, index);
+  std::vector<uint8_t> rgb(kWidth * kHeight * 3);
+  std::vector<uint16_t> depth_mm(kWidth * kHeight);
+  for (int i = 0; i < kWidth * kHeight; ++i) {
+    depth_mm[i] = static_cast<uint16_t>(900 + 7 * i + 13 * index);
+    for (int c = 0; c < 3; ++c) rgb[3 * i + c] = static_cast<uint8_t>(i * (c + 1) + index);
+  }
+  depth_mm[5] = 0;  // no return: a NaN point
+  f.set<uint8_t>("front.rgb", {kHeight, kWidth, 3}, rgb);
+  f.set<uint16_t>("front.depth_mm", {kHeight, kWidth}, depth_mm);
+  f.set<double>("front.intrinsics", {3, 3}, std::vector<double>{30, 0, 12, 0, 30, 8, 0, 0, 1});
+  f.set<double>("front.extrinsics", {4, 4},
+                std::vector<double>{1, 0, 0, 0.1 * index, 0, -1, 0, 0.2, 0, 0, -1, 1.8, 0, 0, 0, 1});
+  return f;
+}
+
+bool same_bytes(const voxels::ObservationCloud& a, const voxels::ObservationCloud& b) {
+  return a.xyz.size() == b.xyz.size() && a.rgb == b.rgb &&
+         std::memcmp(a.xyz.data(), b.xyz.data(), a.xyz.size() * sizeof(float)) == 0;  // NaN too
 }
 
 void add_episode(ReplayBuffer& replay, int64_t episode, int transitions, bool demo) {
@@ -183,4 +209,45 @@ TEST(ReplayBuffer, RestoredPrioritiesKeepTheLargestEverForNewTransitions) {
   forgetful.restore_priorities(saved, 1.0);
   add_episode(forgetful, 2, 1, false);
   EXPECT_NE(forgetful.priority(3), straight.priority(3));
+}
+
+// The replay keeps each frame's point cloud once it is first asked for: the same bytes as one
+// computed from the frame again, within its memory budget, and gone with the frame.
+TEST(ReplayBuffer, KeptPointCloudsEqualRecomputedOnesByteForByte) {
+  ReplayOptions options;
+  options.capacity = 2;
+  ReplayBuffer replay(options);
+  for (int e = 0; e < 2; ++e) {
+    replay.add(depth_frame(e, 0));
+    replay.add(depth_frame(e, 1));
+    replay.add(transition(e, 0, 1, false));
+  }
+  EXPECT_EQ(replay.cloud_memory_used(), 0u);  // nothing computed before it is asked for
+  for (std::size_t i = 0; i < replay.size(); ++i) {
+    const auto kept = replay.cloud_of(i), next = replay.next_cloud_of(i);
+    EXPECT_TRUE(same_bytes(*kept, voxels::observation_cloud(replay.frame_of(i)))) << i;
+    EXPECT_TRUE(same_bytes(*next, voxels::observation_cloud(replay.next_frame_of(i)))) << i;
+    EXPECT_EQ(replay.cloud_of(i), kept) << "asked again: the kept one";
+    EXPECT_TRUE(std::isnan(kept->xyz[15]));
+  }
+  const std::size_t four = replay.cloud_memory_used();
+  EXPECT_GT(four, 4u * 24 * 16 * 15);
+  // Full: a new transition evicts episode 0's, and its frames' clouds go with it.
+  replay.add(depth_frame(2, 0));
+  replay.add(depth_frame(2, 1));
+  replay.add(transition(2, 0, 1, false));
+  EXPECT_EQ(replay.cloud_memory_used(), four / 2);
+
+  // A budget for one cloud keeps the first; the others are computed at every use, alike.
+  ReplayOptions small;
+  small.cloud_memory_bytes = four / 4;
+  ReplayBuffer tight(small);
+  tight.add(depth_frame(0, 0));
+  tight.add(depth_frame(0, 1));
+  tight.add(transition(0, 0, 1, false));
+  const auto first = tight.cloud_of(0), second = tight.next_cloud_of(0);
+  EXPECT_EQ(tight.cloud_memory_used(), four / 4);
+  EXPECT_NE(tight.next_cloud_of(0), second) << "not kept: computed again";
+  EXPECT_TRUE(same_bytes(*tight.next_cloud_of(0), *second));
+  EXPECT_EQ(tight.cloud_of(0), first);
 }
