@@ -82,7 +82,11 @@ class RealSense:
     """One RealSense, colour and depth streams, depth aligned to colour."""
 
     def __init__(self, width, height, fps, serial, settle):
-        import pyrealsense2 as rs  # pip install pyrealsense2
+        try:
+            import pyrealsense2 as rs
+        except ImportError:
+            sys.exit("realsense_recorder.py: the RealSense SDK's Python module is not installed: "
+                     "pip install pyrealsense2 (Intel's librealsense; not a Debian package)")
         self.rs, self.settle = rs, settle
         self.pipeline = rs.pipeline()
         config = rs.config()

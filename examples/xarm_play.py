@@ -296,7 +296,11 @@ def connect(ip):
     """The arm at `ip` through UFACTORY's SDK: errors cleared, motors and gripper enabled."""
     if not ip:
         sys.exit("--ip is required (or --dry-run)")
-    from xarm.wrapper import XArmAPI  # pip install xarm-python-sdk
+    try:
+        from xarm.wrapper import XArmAPI
+    except ImportError:
+        sys.exit("the xArm SDK's Python module is not installed: pip install xarm-python-sdk "
+                 "(UFACTORY's; not a Debian package)")
     arm = XArmAPI(ip)
     arm.clean_error()
     arm.motion_enable(enable=True)

@@ -67,7 +67,7 @@ static void run(const cli::Arguments& args) {
   stream::RecordReader reader(args.input());
   stream::RecordWriter writer(args.text("output"));
   // The map before the stream is committed: a map that cannot be written leaves no --output.
-  stream::run_stage(filter, [&] { return reader.next(); }, [&](const stream::Record& r) { writer.write(r); });
+  stream::run_stage(filter, reader, [&](const stream::Record& r) { writer.write(r); });
   if (args.has("octomap")) {
     if (!filter.last_scene()) throw Error("--octomap: no action was planned, so there is no scene map");
     filter.last_scene()->write_binary(args.text("octomap"));

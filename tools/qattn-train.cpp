@@ -1,4 +1,5 @@
 // qattn-train: the learner. Replayed transitions in, Q-attention network checkpoints out.
+#include <filesystem>
 #include <iostream>
 
 #include "cli/command.hpp"
@@ -73,6 +74,8 @@ static cli::Usage usage() {
   u.options = {
       {"checkpoint-dir", "DIR", "where checkpoints go (required)", ""},
       {"resume", "", "continue from DIR/latest.rec when it exists", ""},
+      {"overwrite", "", "start over in a DIR that holds a run (its checkpoints are replaced); without it or "
+                        "--resume such a DIR is refused", ""},
       {"steps-allowed", "N", "print the gradient steps --follow allows after N agent transitions (with --pretrain and "
                              "--replay-ratio) and exit: the pacing rule, for scripts that wait on the learner", ""},
       {"keep", "N", "numbered checkpoints to keep", "3"},
@@ -111,6 +114,11 @@ static void run(const cli::Arguments& args) {
   }
   if (!args.has("checkpoint-dir")) throw UsageError("--checkpoint-dir is required");
   if (args.positional().empty()) throw UsageError("missing argument FILE");
+  const std::string run_checkpoint = args.text("checkpoint-dir") + "/latest.rec";
+  if (args.flag("resume") && args.flag("overwrite")) throw UsageError("--resume and --overwrite exclude each other");
+  if (!args.flag("resume") && !args.flag("overwrite") && std::filesystem::exists(run_checkpoint))
+    throw UsageError("--checkpoint-dir " + args.text("checkpoint-dir") + " holds a run (" + run_checkpoint +
+                     "): --resume continues it, --overwrite starts over");
   const replay::ReplayOptions replay_options = learner::replay_options_from(args);
 
   nets::set_torch_threads(loop.threads);

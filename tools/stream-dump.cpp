@@ -13,6 +13,7 @@
 #include "stream/inspect.hpp"
 #include "stream/npy.hpp"
 #include "stream/reader.hpp"
+#include "stream/record_types.hpp"
 #include "stream/stream_options.hpp"
 
 using namespace qte;
@@ -78,6 +79,9 @@ static void run(const cli::Arguments& args) {
   const std::vector<std::string> files = args.inputs();
   const auto wanted = args.all("type");
   const std::set<std::string> types(wanted.begin(), wanted.end());
+  for (const std::string& type : types)
+    if (!stream::find_record_type(type))
+      throw UsageError("--type " + type + ": no such record type (the types: " + stream::record_type_names() + ")");
   stream::InspectOptions inspect;
   inspect.max_values = args.flag("all-values") ? -1 : args.integer("values", -1, 1000000000);
   if (args.flag("per-record") && !args.has("npy")) throw UsageError("--per-record goes with --npy DIR");

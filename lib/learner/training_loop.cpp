@@ -16,6 +16,7 @@
 #include "common/atomic_file.hpp"
 #include "common/error.hpp"
 #include "common/random.hpp"
+#include "stream/record_types.hpp"
 
 namespace qte::learner {
 namespace {
@@ -105,6 +106,7 @@ void TrainingLoop::ingest(int64_t agent_limit, bool fill_to_start_after, int64_t
       ++transitions_read_;
       agent_transitions_ += agent;
     }
+    ++records_read_[r.type()];
     replay_.add(r);
     pending_.pop_front();
   }
@@ -206,6 +208,10 @@ void TrainingLoop::train() {
                        (static_cast<int64_t>(replay_.size()) >= options_.start_after || pretraining) &&
                        (!options_.follow || agent_transitions_ >= needed);
     if (!ready) {
+      if (!options_.follow && replay_.size() == 0 && !records_read_.empty())
+        throw Error("the inputs hold no transitions, only " + stream::describe_counts(records_read_) +
+                    " records: the learner reads keyframe's replay ('frame' and 'transition' records), so run "
+                    "keyframe on demonstrations or episodes first");
       if (!options_.follow)
         throw Error("the inputs hold " + std::to_string(replay_.size()) + " transitions, fewer than --start-after " +
                     std::to_string(options_.start_after));

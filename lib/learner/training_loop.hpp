@@ -15,6 +15,7 @@
 #include <deque>
 #include <fstream>
 #include <iosfwd>
+#include <map>
 #include <string>
 
 #include "learner/q_learner.hpp"
@@ -80,6 +81,7 @@ class TrainingLoop {
   LoopOptions options_;
   std::ostream& progress_;
   std::deque<stream::Record> pending_;
+  std::map<std::string, int64_t> records_read_;  // by type, for a message on inputs that hold no transitions
   int64_t transitions_read_ = 0, agent_transitions_ = 0, last_saved_ = -1;
   bool fresh_ = false;  // started without a checkpoint to resume
   // A fresh run that saved only its initial weights: nothing worth keeping if it fails.

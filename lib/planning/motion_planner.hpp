@@ -123,6 +123,7 @@ class PlanPathFilter : public stream::Stage {
  public:
   PlanPathFilter(const robot::RobotModel& robot, const Eigen::Isometry3d& world_from_base, PlannerOptions options);
   void handle(const stream::Record& record, const stream::Emit& emit) override;
+  std::vector<std::string> reads() const override { return {"action"}; }
   // Plans on what `prepare` makes of each observation (point-cloud filters) instead of the
   // observation itself; records still pass through unchanged.
   void observe_through(std::function<stream::Record(const stream::Record&)> prepare) { prepare_ = std::move(prepare); }

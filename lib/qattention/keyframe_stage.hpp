@@ -29,6 +29,7 @@ class KeyframeStage : public stream::Stage {
   // `ignore_collisions`: every action's, as qte-select --ignore-collisions sets it for networks.
   KeyframeStage(std::vector<std::vector<Choice>> demonstrations, std::string source, bool ignore_collisions);
   void handle(const stream::Record& record, const stream::Emit& emit) override;
+  std::vector<std::string> reads() const override { return {"obs"}; }
 
  private:
   std::vector<std::vector<Choice>> demonstrations_;

@@ -28,6 +28,7 @@ class SelectStage : public stream::Stage {
  public:
   SelectStage(CheckpointNetworks& networks, SelectOptions options);
   void handle(const stream::Record& record, const stream::Emit& emit) override;
+  std::vector<std::string> reads() const override { return {"obs"}; }
   uint64_t actions() const { return actions_; }
 
  private:

@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <string>
 #include <tuple>
 
 #include "report/csv.hpp"
 #include "stream/reader.hpp"
+#include "stream/stage.hpp"
 
 namespace qte::report {
 namespace {
@@ -57,7 +60,12 @@ void EpisodeSplitter::finish() {
 std::vector<Episode> read_episodes(const std::string& path, std::function<void(const std::string&)> report) {
   stream::RecordReader reader(path);
   EpisodeSplitter splitter(path, std::move(report));
-  while (auto record = reader.next()) splitter.handle(*record);
+  std::map<std::string, int64_t> counts;
+  while (auto record = reader.next()) {
+    ++counts[record->type()];
+    splitter.handle(*record);
+  }
+  stream::require_record_types(reader, counts, {"obs"});  // a replay is not episodes
   splitter.finish();
   return splitter.episodes();
 }

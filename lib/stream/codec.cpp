@@ -3,6 +3,7 @@
 #include <zlib.h>
 #include <zstd.h>
 
+#include <algorithm>
 #include <cstring>
 #include <functional>
 #include <limits>
@@ -64,11 +65,16 @@ uint32_t crc32_of(const uint8_t* bytes, std::size_t n) {
   return static_cast<uint32_t>(crc);
 }
 
+void require_magic(const uint8_t* bytes, std::size_t n, const StreamPosition& where) {
+  n = std::min(n, sizeof kMagic);
+  if (std::memcmp(bytes, kMagic, n) != 0)
+    throw StreamError(where, "bad magic: expected 89 51 54 45 0d 0a 1a 0a (a QTE record "
+                             "stream), got " + hex_bytes(bytes, n));
+}
+
 RecordHeader decode_header(const uint8_t* h, uint64_t max_payload_bytes,
                            const StreamPosition& where) {
-  if (std::memcmp(h, kMagic, sizeof kMagic) != 0)
-    throw StreamError(where, "bad magic: expected 89 51 54 45 0d 0a 1a 0a (a QTE record "
-                             "stream), got " + hex_bytes(h, 8));
+  require_magic(h, sizeof kMagic, where);
   const uint32_t stored_crc = load<uint32_t>(h + 60);
   const uint32_t actual_crc = crc32_of(h, 60);
   if (kVerifyChecksums && stored_crc != actual_crc)

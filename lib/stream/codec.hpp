@@ -28,6 +28,9 @@ struct RecordHeader {
 };
 
 // Parses and checks the 64 header bytes (magic, header CRC, version, type, length).
+// Throws StreamError ("bad magic ... a QTE record stream") unless the first min(n, 8) bytes are
+// the magic: a file too short for a header is told apart from a short stream alike.
+void require_magic(const uint8_t* bytes, std::size_t n, const StreamPosition& where);
 RecordHeader decode_header(const uint8_t* bytes, uint64_t max_payload_bytes,
                            const StreamPosition& where);
 

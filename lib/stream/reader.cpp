@@ -50,7 +50,12 @@ class MemorySource : public ByteSource {
 };
 
 std::unique_ptr<ByteSource> open_path(const std::string& path) {
-  if (path == "-") return std::make_unique<FdSource>(0, false, "<stdin>");
+  if (path == "-") {
+    // A person at a terminal, not a pipe: waiting for a binary stream typed by hand helps nobody.
+    if (::isatty(0))
+      throw UsageError("standard input is a terminal: give the input file, or pipe a record stream in");
+    return std::make_unique<FdSource>(0, false, "<stdin>");
+  }
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) throw_system_error("cannot open " + path);
   return std::make_unique<FdSource>(fd, true, path);
@@ -87,6 +92,7 @@ std::optional<Record> RecordReader::next() {
   uint8_t header_bytes[kHeaderBytes];
   const std::size_t got = read_fully(header_bytes, kHeaderBytes);
   if (got == 0) return std::nullopt;
+  if (got < kHeaderBytes) require_magic(header_bytes, got, position_);  // not a stream at all, however short
   if (got < kHeaderBytes)
     throw StreamError(position_, "truncated stream: expected a 64-byte record header, got " +
                                      std::to_string(got) + " bytes");

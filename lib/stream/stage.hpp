@@ -4,7 +4,10 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "stream/reader.hpp"
 #include "stream/record.hpp"
@@ -26,11 +29,22 @@ class Stage {
   virtual void finish(const Emit&) {}
   // True when the stage wants no more input (sim-step after its planned episodes).
   virtual bool done() const { return false; }
+  // The record types it acts on (empty: any, or none needed). Given records, but none of these
+  // (a replay where observations belong), run_stage refuses the stream at its end, naming what
+  // it held and which programs write the right ones.
+  virtual std::vector<std::string> reads() const { return {}; }
 };
 
 // start, each record of `next` (until it returns nothing or the stage is done), finish.
 void run_stage(Stage& stage, const std::function<std::optional<Record>()>& next, const Emit& emit);
-// The same from a reader to a writer, which is closed at the end.
+// The same from a reader, with the check of Stage::reads() at the end of its stream.
+void run_stage(Stage& stage, RecordReader& reader, const Emit& emit);
+// The same to a writer, which is closed at the end (not when the input is refused).
 void run_stage(Stage& stage, RecordReader& reader, RecordWriter& writer);
+// Throws StreamError at the reader's position when `counts` (records read, by type) holds
+// records but none of a type in `wanted`: "expected 'obs' records (observations, written by ...);
+// the stream held 3 'frame', 2 'transition' (...)".
+void require_record_types(const RecordReader& reader, const std::map<std::string, int64_t>& counts,
+                          const std::vector<std::string>& wanted);
 
 }  // namespace qte::stream

@@ -38,6 +38,7 @@ class VoxelizeStage : public stream::Stage {
                 std::function<stream::Record(const stream::Record&)> prepare = nullptr)
       : options_(std::move(options)), png_dir_(std::move(png_dir)), prepare_(std::move(prepare)) {}
   void handle(const stream::Record& record, const stream::Emit& emit) override;
+  std::vector<std::string> reads() const override { return {"obs"}; }
 
  private:
   void save_pictures(uint64_t record_index, const std::vector<float>& grids) const;
