@@ -54,15 +54,17 @@ static cli::Usage usage() {
       {"per-record", "", "with --npy, write one .npy file per record and field instead of stacked arrays", ""},
       {"pcd", "DIR", "also export every camera's point cloud of the shown observations as .pcd files into DIR", ""},
       {"summary", "", "print only a count of records and bytes per type at the end", ""},
+      {"text", "", "with --npy or --pcd, print the records as well (without it those write files only; --json "
+                   "prints them as JSON Lines)", ""},
       stream::max_record_bytes_option(),
   };
   u.examples = {
       {"stream-dump demos.rec", "list every record of a file with its fields"},
       {"stream-dump --json --type obs demos.rec | jq '.fields[].name'",
        "field names of the observations"},
-      {"stream-dump --summary --type obs --npy arrays/ demos.rec && ls arrays/",
+      {"stream-dump --type obs --npy arrays/ demos.rec && ls arrays/",
        "the observations as stacked NumPy arrays (arrays/obs.front.rgb.npy, ...)"},
-      {"stream-dump --summary --pcd clouds/ episode.rec && pcl_viewer clouds/000000.front.pcd",
+      {"stream-dump --pcd clouds/ episode.rec && pcl_viewer clouds/000000.front.pcd",
        "look at the first observation's point cloud in PCL's viewer"},
   };
   u.see_also = {"qte-stream(5)", "stream-cat(1)", "stream-pack(1)"};
@@ -96,6 +98,9 @@ static void run(const cli::Arguments& args) {
   if (npy_out) npy = std::make_unique<stream::NpyExport>(npy_out->staging(), args.flag("per-record"));
   const stream::ReadOptions read_options = stream::read_options_from(args);
 
+  // Exporting is what --npy and --pcd are for: the text too only when asked for.
+  const bool print_records =
+      !args.flag("summary") && (args.flag("json") || args.flag("text") || (!npy_out && !args.has("pcd")));
   std::map<std::string, std::pair<uint64_t, uint64_t>> totals;  // type -> (records, bytes)
   for (const std::string& file : files) {
     stream::RecordReader reader(file, read_options);
@@ -111,7 +116,7 @@ static void run(const cli::Arguments& args) {
         for (const auto& camera : voxels::camera_clouds(*record))
           point_clouds::write_pcd(pcd->path(indexed_name(record->position.record_index, camera.camera + ".pcd")), camera);
       if (npy) npy->add(*record);
-      if (args.flag("summary")) continue;
+      if (!print_records) continue;
       if (args.flag("json")) stream::print_record_json(std::cout, *record, bytes, inspect);
       else stream::print_record_text(std::cout, *record, bytes, inspect);
       flush_or_stop();

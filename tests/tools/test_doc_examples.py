@@ -6,7 +6,8 @@ A runnable example is a fenced block whose info string is `sh runnable`. The blo
 document run in order, each as `bash -euo pipefail`, in one scratch directory per document that
 starts empty, with the built programs first on PATH; every document makes its own inputs. A
 block that fails is reported with its document and line. The README's learning pipeline must
-also have taken learner steps (its train.csv) and printed success rates (episode-stats)."""
+also have taken learner steps (its train.csv) and printed success rates (episode-stats), and
+docs/learning-loop.md's small online loop learner steps on the agent's own transitions."""
 import csv
 import os
 import re
@@ -60,6 +61,22 @@ def check_readme_learning(scratch, output, failures):
     print(f"README.md learning pipeline: {max(steps or [0])} learner steps; evaluation:\n{output.strip()}")
 
 
+def check_online_loop(scratch, failures):
+    """docs/learning-loop.md's small loop trained on the agent's own transitions: train.csv has
+    rows after the 10 pretraining steps, with agent transitions in the replay."""
+    metrics = os.path.join(scratch, "train.csv")
+    if not os.path.exists(metrics):
+        failures.append("docs/learning-loop.md: the online loop wrote no train.csv")
+        return
+    with open(metrics) as f:
+        rows = [(int(r["step"]), int(r["agent_transitions"])) for r in csv.DictReader(f)]
+    online = [step for step, agent in rows if step > 10 and agent > 0]
+    if not online:
+        failures.append(f"docs/learning-loop.md: the learner took no step on agent transitions (step, agent "
+                        f"transitions: {rows})")
+    print(f"docs/learning-loop.md online loop: steps on agent transitions up to {max(online or [0])}")
+
+
 def main():
     env = dict(os.environ, PATH=os.path.abspath(TOOLS) + os.pathsep + os.environ.get("PATH", ""))
     failures, ran = [], 0
@@ -86,6 +103,8 @@ def main():
         else:
             if name == "README.md" and any("qattn-train" in text for _, text in blocks):
                 check_readme_learning(scratch, "".join(outputs), failures)
+            if name == os.path.join("docs", "learning-loop.md"):
+                check_online_loop(scratch, failures)
         shutil.rmtree(scratch, ignore_errors=True)
     if ran == 0:
         failures.append("no block marked 'sh runnable' in README.md or docs/")
