@@ -33,7 +33,7 @@ for task in reach_target pick_and_lift lift_numbered_block; do
 done
 ls -l "$out"/demos_*.rec "$out"/transitions_*.rec >&2
 
-say "4. what the agent sees: the voxel grid at depth 0 and a crop around the first keyframe (voxelize)"
+say "4. what the agent sees: the voxel grid at depth 0 and the depth-1 grid around a fixed centre, 0.1, 0, 0.8 m (voxelize)"
 stream-cat --type obs --head 1 "$out/demos_lift_numbered_block.rec" \
   | voxelize --png "$out/voxels" --centre 0.1,0.0,0.8 --output "$out/voxels.rec"
 ls "$out/voxels" >&2

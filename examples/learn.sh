@@ -110,6 +110,13 @@ branching() {  # K -> the options that go with it
 }
 act_branching=$(branching "$ACT_K") target_branching=$(branching "$TARGET_K")
 log() { printf '%s %s\n' "$(date +%H:%M:%S)" "$*" >&2; }
+# An evaluation's row (episode-stats' CSV, header first) in words.
+evaluation_summary() {  # CSV
+  awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) col[$i] = i; next }
+           { printf "success %s (%s of %s held-out episodes, 95%% interval %.2f-%.2f), %s s of training", \
+                    $col["success_rate"], $col["successes"], $col["episodes"], $col["ci95_low"], $col["ci95_high"], \
+                    $col["train_s"] }' "$1"
+}
 # Processor time of the run, split by role, summed over resumptions (evaluations and the failure
 # analysis excluded), in ticks in cpu_ticks ("demos pretrain learner actor other"): demos,
 # the demonstrations; pretrain and learner, the learner process before and after step
@@ -311,6 +318,22 @@ if [ "$ROLE" = actor ]; then
   exit 0
 fi
 
+# What this run will do, and how long the committed runs of the same task and label trained
+# (examples/results/, the last evaluation's train_s: wall-clock with evaluations excluded).
+committed_minutes() {
+  local files=("$(dirname "$0")"/results/*/"${task}_${LABEL}"-seed*.csv)
+  [ -f "${files[0]}" ] || return 0
+  awk -F, 'FNR == 1 { split("", col); for (i = 1; i <= NF; i++) col[$i] = i; next }
+           { last[FILENAME] = $col["train_s"] }
+           END { for (f in last) if (last[f] > 0) print last[f] / 60 }' "${files[@]}" | sort -n \
+    | awk '{ t[NR] = $1 } END { if (NR) printf "%.0f min (median of %d committed runs)", t[int((NR + 1) / 2)], NR }'
+}
+if [ "$ROLE" != actor ] && [ ! -f "$run/eval.csv" ]; then
+  log "$task $LABEL seed $SEED: $DEMOS demonstrations, $ENV_STEPS environment steps in chunks of $CHUNK_EPISODES episodes, $PRETRAIN pretraining steps then $RATIO learner steps per agent transition (batch $BATCH, $N_STEP-step targets, tree target K = $TARGET_K), acting with K = $ACT_K; evaluated every $EVAL_EVERY steps on $EVAL_EPISODES held-out scenes${CPU_BUDGET:+, processor budget $CPU_BUDGET s}; networks in $PRECISION${NET_OPTIONS:+, $NET_OPTIONS}"
+  expected=$(committed_minutes)
+  [ -z "$expected" ] || log "$task $LABEL: the committed runs trained for $expected on 2 cores, evaluations excluded"
+fi
+
 # 1. Demonstrations -> transitions (once; written under a temporary name, then renamed).
 if [ ! -f "$run/replay.rec" ]; then
   before=$(shell_ticks)
@@ -404,7 +427,7 @@ while :; do
     evaluate "$snapshot" "$env_steps" "$eval_csv" "$step" "$point"
     eval_ticks=$(( eval_ticks + $(shell_ticks) - before ))
     clock=$(date +%s)
-    log "$task $LABEL seed $SEED: env steps $env_steps, learner step $step: $(tail -1 "$eval_csv")"
+    log "$task $LABEL seed $SEED: env steps $env_steps, learner step $step: $(evaluation_summary "$eval_csv")"
   fi
   [ "$finished" = 0 ] || break
   # A split run's learner: the actors (elsewhere) add chunks; look again in a while.

@@ -38,6 +38,11 @@ kill -0 $learn_pid 2>/dev/null && fail "learn.sh still running 30 s after its le
 wait $learn_pid && fail "learn.sh exited 0 after its learner died"
 grep -q "the learner (qattn-train, pid $learner) died, killed by signal KILL; last line of $run/train.log: " "$tmp/learn.log" \
   || fail "no line naming the dead learner: $(cat "$tmp/learn.log")"
+# The run said at its start what it would do (its settings) and what its evaluations found, in words.
+grep -q "reach_target .* seed 0: 2 demonstrations, [0-9]* environment steps in chunks of [0-9]* episodes, .*held-out scenes, processor budget [0-9]* s; networks in " "$tmp/learn.log" \
+  || fail "no line of the run's settings: $(head -3 "$tmp/learn.log")"
+grep -q "learner step [0-9]*: success [0-9.]* ([0-9]* of [0-9]* held-out episodes, 95% interval" "$tmp/learn.log" \
+  || fail "no evaluation in words: $(grep 'learner step' "$tmp/learn.log")"
 [ "$(sort -u <<<"${actors[*]// /$'\n'}" | grep -c .)" = 1 ] || fail "qte-select processes: ${actors[*]}"
 sleep 1
 pgrep -f "$run" > /dev/null && fail "programs of the run still running: $(pgrep -af "$run")"
