@@ -106,6 +106,9 @@ static Eigen::AlignedBox3d workspace_from(const cli::Arguments& args) {
 static void run(const cli::Arguments& args) {
   if (!args.has("spool")) throw UsageError("give --spool DIR, the directory the robot's drivers answer in");
   if (args.has("judge") && args.has("outcomes")) throw UsageError("--judge and --outcomes: give one");
+  // An empty command would run whatever the shell makes of its arguments alone (the system's reset).
+  if (args.has("judge") && args.text("judge").find_first_not_of(" \t") == std::string::npos)
+    throw UsageError("--judge: give the command that judges (empty: the person at --terminal judges without it)");
   std::optional<sim_step::EpisodePlan> plan;
   if (args.has("task")) plan = sim_step::parse_episode_plan(args, args.text("task"));
 

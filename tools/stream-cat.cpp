@@ -1,6 +1,7 @@
 // stream-cat: concatenate, filter and validate record streams.
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include "cli/command.hpp"
 #include "stream/record_filter.hpp"
@@ -51,7 +52,7 @@ static void run(const cli::Arguments& args) {
                                args.assignments("where"),
                                args.integer("head", -1, 1000000000000000)});
   const stream::ReadOptions read_options = stream::read_options_from(args);
-  stream::RecordWriter writer(args.text("output"), stream::write_options_from(args, files));
+  const stream::WriteOptions write_options = stream::write_options_from(args, files);
   std::size_t next_file = 0;
   std::unique_ptr<stream::RecordReader> reader;
   // The inputs one after another, each opened when the one before has ended.
@@ -63,6 +64,17 @@ static void run(const cli::Arguments& args) {
       reader = std::make_unique<stream::RecordReader>(files[next_file++], read_options);
     }
   };
+  if (write_options.mode == stream::WriteMode::append && args.text("output") != "-") {
+    // All or nothing: the inputs are read whole (and so checked) before the first record is
+    // appended, so a damaged input leaves the file as it was.
+    std::vector<stream::Record> held;
+    stream::run_stage(filter, next, [&](const stream::Record& r) { held.push_back(r); });
+    stream::RecordWriter writer(args.text("output"), write_options);
+    for (const stream::Record& r : held) writer.write(r);
+    writer.close();
+    return;
+  }
+  stream::RecordWriter writer(args.text("output"), write_options);
   stream::run_stage(filter, next, [&](const stream::Record& r) { writer.write(r); });
   writer.close();
 }

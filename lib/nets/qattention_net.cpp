@@ -133,6 +133,12 @@ QValues QAttentionNet::predict_leaves(const float* grids, const float* proprio, 
                                         {n, config_.proprio});
     Trunk trunk = module_->trunk(channels_first(grid), state);
     append(values.translation, trunk.translation);
+    // Q values that are not finite, or absurd (the rewards are 0..1; beyond 1e30 sums overflow),
+    // cannot be ranked: the networks are at fault, damaged or diverged weights, not the input.
+    const double largest = trunk.translation.abs().max().item<double>();
+    if (!(largest <= 1e30))
+      throw Error("the depth-" + std::to_string(config_.depth) + " network's Q values reach " + std::to_string(largest) +
+                  ": its checkpoint's weights are damaged or diverged");
     if (!config_.is_last) continue;
     // Kept activations are bounded: a larger batch (a deep tree's leaves) gets its heads now.
     if (first == 0) heads_later = static_cast<double>(level_bytes(trunk)) / n * batch <= keep_bytes;

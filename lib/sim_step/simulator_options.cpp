@@ -42,11 +42,14 @@ std::vector<cli::OptionSpec> episode_options(int default_episodes, SceneSet defa
 }
 
 EpisodePlan parse_episode_plan(const cli::Arguments& args, const std::string& task) {
-  tasks::make_task(task);  // an unknown task fails before anything is written
+  const auto made = tasks::make_task(task);  // an unknown task fails before anything is written
   EpisodePlan plan;
   plan.task = task;
   plan.episodes = static_cast<int>(args.integer("episodes", 1, 10000000));
-  plan.variation = args.text("variation") == "random" ? -1 : static_cast<int>(args.integer("variation", 0, 1000));
+  // The task's own range: a usage error naming the option, before any input is read.
+  plan.variation = args.text("variation") == "random"
+                       ? -1
+                       : static_cast<int>(args.integer("variation", 0, made->variation_count() - 1));
   plan.seed = args.seed();
   plan.scenes = scene_set_from_name(args.text("scenes"));
   return plan;

@@ -70,6 +70,18 @@ err=$(ulimit -f $(( (before + whole + whole / 2) / 1024 )); stream-cat "$tmp/thr
 stream-cat "$tmp/one.rec" --append --output "$tmp/limited.rec" || fail "append after the size limit"
 [ "$(records "$tmp/limited.rec")" = "5 records" ] || fail "after the size limit: $(records "$tmp/limited.rec")"
 
+# All or nothing: an input damaged at its third record appends none of the records before it,
+# with or without --repair.
+cp "$tmp/three.rec" "$tmp/damaged.rec"
+third=$(( $(size "$tmp/three.rec") / 3 * 2 + 70 ))  # inside the third record's payload
+printf 'XXXX' | dd of="$tmp/damaged.rec" bs=1 seek="$third" conv=notrunc 2> /dev/null
+for repair in "" --repair; do
+  cp "$tmp/one.rec" "$tmp/target.rec"
+  err=$(stream-cat "$tmp/one.rec" "$tmp/damaged.rec" --append $repair --output "$tmp/target.rec" 2>&1); rc=$?
+  [ "$rc" = 1 ] && grep -q "$tmp/damaged.rec: record 2 at byte" <<<"$err" || fail "damaged input ($repair): exit $rc, $err"
+  cmp -s "$tmp/target.rec" "$tmp/one.rec" || fail "a damaged input ($repair) appended part of itself: $(records "$tmp/target.rec")"
+done
+
 # A new file and an empty file are streams to append to.
 stream-cat "$tmp/one.rec" --append --output "$tmp/new.rec" && : > "$tmp/empty.rec" \
   && stream-cat "$tmp/one.rec" --append --output "$tmp/empty.rec" || fail "append to a new or empty file"

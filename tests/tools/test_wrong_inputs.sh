@@ -65,4 +65,11 @@ if command -v script > /dev/null; then
   done
   [ ! -e "$tmp/s.rec" ] || fail "sim-step at a terminal left its output"
 fi
+# Options checked as options, before any input is read: a task's variation out of its range is
+# a usage error naming the option (not a record of standard input), an empty --judge refused.
+refused "sim-step --variation 99" "--variation|0..19" "$tmp/v.rec" -- \
+  sim-step --task reach_target --variation 99 --output "$tmp/v.rec"
+! grep -q "stdin" "$tmp/err" || fail "--variation 99 blamed standard input: $(cat "$tmp/err")"
+mkdir -p "$tmp/spool"
+refused "robot-step --judge ''" "--judge" "" -- robot-step --spool "$tmp/spool" --camera front --judge '' --output "$tmp/j.rec"
 echo "wrong inputs named"

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <string>
 
 #include "common/error.hpp"
@@ -444,6 +445,27 @@ TEST(Checkpoint, DamagedFileGivesStreamError) {
   write_file(path, bytes);
   EXPECT_NO_THROW(load_checkpoint(path, nets));
   std::remove(path.c_str());
+}
+
+// Networks whose Q values are not finite, or absurd, are refused as the checkpoint's fault
+// (a Q bias of -3e38 once reached the tree as "row -1 of 10").
+TEST(QAttentionNet, NonFiniteOrAbsurdQValuesAreTheNetworksFault) {
+  seed_torch(2);
+  std::vector<float> grids(2 * V * V * V * C, 0.1f), proprio(2 * 4, 0.5f);
+  for (const float bias : {-3e38f, std::numeric_limits<float>::infinity(), std::nanf("")}) {
+    auto nets = make_coarse_to_fine_nets(config_of(Architecture::light, 16), 2);
+    {
+      torch::NoGradGuard no_grad;
+      for (auto& item : nets[0].module().named_parameters())
+        if (item.key().rfind("q.", 0) == 0 && item.key().find("bias") != std::string::npos) item.value().fill_(bias);
+    }
+    try {
+      nets[0].predict(grids.data(), proprio.data(), 2);
+      FAIL() << "Q bias " << bias << " accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("damaged or diverged"), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace
