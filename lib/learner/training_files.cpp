@@ -83,6 +83,12 @@ std::vector<stream::Record> InputFollower::poll() {
   return records;
 }
 
+bool InputFollower::only_files() const {
+  for (const auto& input : inputs_)
+    if (!input->growing) return false;
+  return true;
+}
+
 bool InputFollower::finished() const {
   for (const auto& input : inputs_) {
     if (input->growing) return false;

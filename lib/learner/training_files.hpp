@@ -26,6 +26,8 @@ class InputFollower {
   std::vector<stream::Record> poll();  // throws the StreamError of a damaged input
   // True when no input can grow any more (no follow, or every FIFO closed; files can always grow).
   bool finished() const;
+  // True when every input is a followed regular file: poll() reads each to its current end.
+  bool only_files() const;
 
  private:
   struct Input;

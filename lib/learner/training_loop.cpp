@@ -147,6 +147,13 @@ bool TrainingLoop::start(bool resume) {
       if (!options_.follow || inputs_.finished())
         throw Error(checkpoints_.latest() + ": the checkpoint was taken after " + std::to_string(want) +
                     " transitions, the inputs hold " + std::to_string(transitions_read_));
+      // Files are read to their end at every poll, and what the checkpoint read was in them
+      // before it: fewer now means records were lost (a file system that dropped recent
+      // appends), and waiting for them would never end.
+      if (inputs_.only_files())
+        throw Error(checkpoints_.latest() + ": the checkpoint was taken after " + std::to_string(want) +
+                    " transitions, its input files now hold " + std::to_string(transitions_read_) +
+                    ": they lost records since; rebuild the replay, or start over with --overwrite");
       std::this_thread::sleep_for(options_.poll);
     }
     const auto priorities = state.array<double>("priorities");

@@ -49,6 +49,13 @@ cmp -s "$tmp/ckpt0/latest.rec" "$tmp/kept.rec" || fail "the refused run replaced
 qattn-train --steps 1 --start-after 0 --overwrite --checkpoint-dir "$tmp/ckpt0" "$tmp/replay.rec" 2> /dev/null \
   || fail "--overwrite did not start over"
 
+# A follower resumed on a replay that has lost records its checkpoint had read (a file system
+# that dropped recent appends) stops at once with one line, instead of waiting for them.
+qattn-train --steps 2 --start-after 0 --checkpoint-dir "$tmp/ckpt2" "$tmp/replay.rec" 2> /dev/null || fail "a run to resume"
+stream-cat --head 12 "$tmp/replay.rec" > "$tmp/lost.rec"
+refused "qattn-train --follow --resume on a shorter replay" "checkpoint was taken after|lost records" "" -- \
+  timeout 60 qattn-train --follow --resume --steps 4 --start-after 0 --checkpoint-dir "$tmp/ckpt2" "$tmp/lost.rec"
+
 # A text file shorter than a record header: the same line as a longer one.
 printf 'hello\n' > "$tmp/short.txt"
 refused "a short text file" "bad magic|a QTE record stream|68 65 6c 6c 6f 0a" "" -- stream-dump "$tmp/short.txt"
