@@ -44,6 +44,23 @@ Pass training_pass(QAttentionModule& net, const torch::Tensor& grid, const torch
   return pass;
 }
 
+// A network of depth 0 or the last depth with its own seed, and a batch of 3 random inputs.
+struct TrunkCase {
+  NetConfig config;
+  std::shared_ptr<QAttentionModule> net;
+  torch::Tensor grid, proprio;
+};
+TrunkCase trunk_case(bool is_last, int seed) {
+  TrunkCase c;
+  c.config.is_last = is_last;
+  c.config.proprio = 5;
+  torch::manual_seed(seed);
+  c.net = make_qattention_module(c.config);
+  c.grid = torch::rand({3, c.config.channels, c.config.voxels, c.config.voxels, c.config.voxels});
+  c.proprio = torch::rand({3, c.config.proprio});
+  return c;
+}
+
 TEST(LightTrunk, IsUsedOnAProcessorWithAvx2) {
   if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "no AVX2: LibTorch's layers are used";
   EXPECT_TRUE(light_trunk_supported(torch::zeros({3, 10, 16, 16, 16}), 16));
@@ -54,13 +71,10 @@ TEST(LightTrunk, IsUsedOnAProcessorWithAvx2) {
 TEST(LightTrunk, EqualsLibTorchsLayersForwardAndBackward) {
   if (!light_trunk_supported(torch::zeros({3, 10, 16, 16, 16}), 16)) GTEST_SKIP() << "oneDNN trunk not supported here";
   for (const bool is_last : {false, true}) {
-    NetConfig config;
-    config.is_last = is_last;
-    config.proprio = 5;
-    torch::manual_seed(11);
-    const auto net = make_qattention_module(config);
-    const auto grid = torch::rand({3, config.channels, config.voxels, config.voxels, config.voxels});
-    const auto proprio = torch::rand({3, config.proprio});
+    const TrunkCase c = trunk_case(is_last, 11);
+    const NetConfig& config = c.config;
+    const auto& net = c.net;
+    const auto &grid = c.grid, &proprio = c.proprio;
     const Pass theirs = training_pass(*net, grid, proprio, false);
     // The weight gradients by oneDNN's own kernel where it has a vectorised one (AVX-512), and
     // swapped (nets/onednn.hpp).
@@ -114,13 +128,10 @@ TEST(LightTrunk, InferenceEqualsTheTrainingForward) {
 TEST(LightTrunk, Bf16EqualsFp32WithinBf16Rounding) {
   if (!bf16_native_here()) GTEST_SKIP() << "no AVX-512 BF16 or AMX here: bf16 runs only where it is native";
   for (const bool is_last : {false, true}) {
-    NetConfig config;
-    config.is_last = is_last;
-    config.proprio = 5;
-    torch::manual_seed(13);
-    const auto net = make_qattention_module(config);
-    const auto grid = torch::rand({3, config.channels, config.voxels, config.voxels, config.voxels});
-    const auto proprio = torch::rand({3, config.proprio});
+    const TrunkCase c = trunk_case(is_last, 13);
+    const NetConfig& config = c.config;
+    const auto& net = c.net;
+    const auto &grid = c.grid, &proprio = c.proprio;
     use_precision(Precision::fp32);
     const Pass fp32 = training_pass(*net, grid, proprio, true);
     use_precision(Precision::bf16);
