@@ -44,7 +44,7 @@ head -c 400 "$out/motion.jsonl" >&2; echo " ..." >&2
 stream-dump --npy "$out/npy" --type obs "$out/reach_target.rec" > /dev/null
 ls "$out/npy" >&2
 
-say "6. the learning loop, short: 5 demos, 60 learner steps on them, 30 exploring steps, greedy evaluation"
+say "6. the learning loop, short: 5 demos, 60 learner steps on them, at least 30 exploring steps (whole chunks of 5 episodes), greedy evaluation"
 # The same loop as `make -C examples reach_target`, on a budget of about two minutes (the
 # full run is 10 demos and 2,000 environment steps). See examples/learn.sh.
 make -s -C examples reach_target RUNS="$(realpath "$out")/runs" BUILD="$(dirname "$(command -v sim-step)")/.." \
