@@ -60,7 +60,7 @@ sanitize: deps
 # decoder, each record type's readers, then the camera files' readers (.pcd; PNG and joint CSV)
 # (tests/fuzz/fuzz_<target>.cpp, seeds in tests/fuzz/corpus/<target>/). A finding is written to
 # tests/fuzz/findings/ and fails the target.
-FUZZ_TARGETS ?= stream_reader obs action trajectory transition checkpoint pcd camera_recordings
+FUZZ_TARGETS ?= stream_reader obs action trajectory transition checkpoint pcd camera_recordings driver_answer
 fuzz: deps
 	cmake -S . -B $(BUILD)-fuzz -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
 	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DQTE_FUZZ=ON -DQTE_TESTS=ON $(CMAKE_FLAGS)

@@ -66,7 +66,7 @@ read -r method_act_k method_target_k <<< "$(method_k "${METHOD:-qte}" 10)"  # ME
 : "${N_STEP:=1}" "${ACTORS:=1}" "${CPU_BUDGET:=0}" "${K_MARGIN:=0.02}" "${K_MAX:=10}" "${ROLE:=all}" "${ACTOR_INDEX:=0}"
 : "${ALSO_ACT_K:=}" "${METHOD:=qte}" "${LABEL:=$(run_label "$METHOD" "$ACT_K" "$TARGET_K" "$K_MARGIN" "$K_MAX")}"
 : "${STAGE:=sim-step --image-size $IMAGE}" "${DEMOS_FROM:=}" "${TIME_BUDGET:=0}" "${NET_OPTIONS:=}"
-: "${PLAN_OPTIONS:=}" "${EVAL_STAGE:=$STAGE}" "${ACCOUNT_EVERY:=30}" "${PRECISION:=auto}"
+: "${PLAN_OPTIONS:=}" "${EVAL_STAGE:=$STAGE}" "${ACCOUNT_EVERY:=30}" "${PRECISION:=auto}" "${STALL_SECONDS:=1800}"
 export PLAN_OPTIONS  # failure_reasons.sh plans the final agent's moves the same way
 eval "stage=($STAGE)"
 eval "eval_stage=($EVAL_STAGE)"
@@ -203,6 +203,20 @@ check_learner() {
   local status=0
   wait "$learner" 2>/dev/null || status=$?
   log "$task $LABEL seed $SEED: the learner (qattn-train, pid $learner) died, $(describe_status "$status"); last line of $run/train.log: $(tail -1 "$run/train.log")"
+  exit 1
+}
+# A learner alive but making no progress while the run waits for it (stopped, or waiting for
+# input that cannot come) stops the run too: STALL_SECONDS without a new checkpoint or a new
+# line in train.csv or train.log. watch_learner_from_now starts each wait's clock.
+watch_learner_from_now() { stall_mark="" stall_since=$SECONDS; }
+check_progress() {
+  check_learner
+  [ -n "$learner" ] || return 0
+  local mark; mark="$(newest_checkpoint_step "$run/ckpt") $({ stat -c %s "$run/train.csv" "$run/train.log" 2>/dev/null || true; } | xargs)"
+  if [ "$mark" != "$stall_mark" ]; then stall_mark=$mark stall_since=$SECONDS; return 0; fi
+  [ $(( SECONDS - stall_since )) -ge "$STALL_SECONDS" ] || return 0
+  log "$task $LABEL seed $SEED: the learner (qattn-train, pid $learner) made no progress in $STALL_SECONDS s (no new checkpoint, no new line in train.csv or train.log; STALL_SECONDS); stopping the run; last line of $run/train.log: $(tail -1 "$run/train.log")"
+  kill -CONT "$learner" 2>/dev/null  # a stopped learner must see the kill that ends the run
   exit 1
 }
 kill_tree() {  # PID...: each process and its descendants, children first
@@ -369,7 +383,8 @@ qattn-train --follow --resume --stop-file "$run/actor.done" --replay-ratio "$RAT
   --checkpoint-dir "$run/ckpt" --metrics "$run/train.csv" "${inputs[@]}" 2>> "$run/train.log" &
 learner=$!
 trap 'kill_tree $(jobs -p)' EXIT  # the learner and the actors, with every program they started
-while [ ! -f "$run/ckpt/latest.rec" ]; do check_learner; nap 0.5; done
+watch_learner_from_now
+while [ ! -f "$run/ckpt/latest.rec" ]; do check_progress; nap 0.5; done
 
 # The learner's newest step, from its checkpoint names.
 learner_step() { newest_checkpoint_step "$run/ckpt"; }
@@ -381,7 +396,8 @@ steps_allowed() { awk -v n="$1" -v p="$PRETRAIN" -v r="$RATIO" 'BEGIN { printf "
 wait_for_learner() {
   local want; want=$(steps_allowed "$1")
   want=$(( want / CHECKPOINT_EVERY * CHECKPOINT_EVERY ))
-  while [ "$(learner_step)" -lt "$want" ]; do check_learner; nap 0.5; done
+  watch_learner_from_now
+  while [ "$(learner_step)" -lt "$want" ]; do check_progress; nap 0.5; done
   # Pretraining ends at step PRETRAIN (the first evaluation waits for it when PRETRAIN is a
   # multiple of CHECKPOINT_EVERY; otherwise up to a checkpoint interval of training counts too).
   if [ "$pretraining" = 1 ] && [ "$(learner_step)" -ge "$PRETRAIN" ]; then

@@ -2,6 +2,7 @@
 // out, with the arm, the camera and the reward behind a spool directory and a judge.
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 
@@ -34,13 +35,23 @@ static cli::Usage usage() {
       "are such drivers.",
       "Safety first: every motion is checked before it is written: finite, starting where the "
       "arm is, within the joint limits, no joint faster than --speed of its limit (slower "
-      "motions are stretched in time to fit), and the gripper inside --workspace along the whole "
-      "path. A motion that fails a check is not sent, and ends the episode with reward 0 and the "
+      "motions are stretched in time to fit), and the whole arm, every link and both fingers "
+      "(the planner's collision spheres), inside --workspace and above the table along the whole "
+      "path; the move to --home is checked the same way along the straight joint-space line the "
+      "driver takes from where the arm last was. A motion that fails a check is not sent, and ends the episode with reward 0 and the "
       "reason, as an invalid action does in sim-step. The stop file (--stop-file), a 'stop' a "
       "person writes in the spool, or a driver that does not answer in time ends robot-step with "
       "exit status 1; an interrupt (SIGINT, SIGTERM) ends it by the signal. Each writes 'stop' in "
       "the spool, which halts the drivers at once, and withdraws the motion not yet answered. "
       "--dry-run sends nothing: it prints each motion and takes it as reached.",
+      "A driver is not trusted: answers are read only from regular files of at most 64 KiB; "
+      "reached joints that are not finite or lie outside the robot's joint limits (by more than "
+      "1 degree) stop the robot as an unreadable answer does; reached joints further than "
+      "--reach-tolerance from the motion's last row end the episode as a driver fault naming "
+      "both poses; when a request has both a fault and another answer, the fault wins; fault "
+      "text and a judge's failure reason go into observations as valid UTF-8 of at most 200 "
+      "bytes. An outcomes file is read a line of at most 4 KiB at a time (16 MiB in all), a "
+      "judge command's output up to 64 KiB.",
       "Episodes: each reset asks for the scene to be set up, then moves the arm to --home with "
       "the gripper open. After each step the outcome comes from a person at the terminal (s "
       "success, f failure, Enter go on; q stops), from a file (--outcomes), or from a command "
@@ -60,8 +71,11 @@ static cli::Usage usage() {
       {"terminal", "TTY", "the terminal a person judges at", "/dev/tty"},
       {"home", "J1,...,J7", "start pose of every episode, joint angles in degrees (default: the simulation's, "
                             "0,-20.05,0,42.97,0,63.03,0: the gripper above the table, pointing down)", ""},
-      {"workspace", "X0,Y0,Z0,X1,Y1,Z1", "box the gripper's tool point must stay in (world frame, m)",
-       "-0.3,-0.5,0.752,0.7,0.5,1.6"},
+      {"workspace", "X0,Y0,Z0,X1,Y1,Z1",
+       "box the whole arm must stay in (world frame, m, within 10 m of the origin; the base excepted)",
+       "-0.65,-0.5,0.752,0.7,0.5,1.6"},
+      {"reach-tolerance", "DEG", "largest difference between a motion's last row and the joints the driver reports",
+       "2"},
       {"speed", "F", "fraction of each joint's speed limit a motion may use (faster ones are slowed)", "1"},
       {"rate", "HZ", "rows per second of the motions handed to the arm (its servo rate)", "100"},
       {"settle", "S", "seconds after a motion's end before its gripper command", "0.5"},
@@ -99,6 +113,8 @@ static robot::JointVector home_from(const cli::Arguments& args) {
 
 static Eigen::AlignedBox3d workspace_from(const cli::Arguments& args) {
   const std::vector<double> v = args.reals("workspace", 6);
+  for (double x : v)  // bounded like every other number: a box of 1e300 m checks nothing
+    if (std::abs(x) > 10) throw UsageError("--workspace: coordinates within 10 m of the world origin, got " + args.text("workspace"));
   if (!(v[0] < v[3] && v[1] < v[4] && v[2] < v[5])) throw UsageError("--workspace: expected X0 < X1, Y0 < Y1, Z0 < Z1");
   return Eigen::AlignedBox3d(Eigen::Vector3d(v[0], v[1], v[2]), Eigen::Vector3d(v[3], v[4], v[5]));
 }
@@ -118,6 +134,7 @@ static void run(const cli::Arguments& args) {
   if (args.has("home")) options.home = home_from(args);
   options.workspace = workspace_from(args);
   options.speed_fraction = args.real("speed", 0.01, 1.0);
+  options.reach_tolerance_deg = args.real("reach-tolerance", 0.01, 30);
   options.rate_hz = args.real("rate", 1, 1000);
   options.settle_s = args.real("settle", 0.01, 10);  // the gripper row needs a time of its own
   options.episode_length = args.has("episode-length") ? static_cast<int>(args.integer("episode-length", 1, 1000))

@@ -19,7 +19,9 @@ std::vector<cli::OptionSpec> camera_setup_options() {
 CameraSetup camera_setup_from(const cli::Arguments& args) {
   CameraSetup camera;
   camera.name = args.text("camera");
-  if (!stream::is_valid_field_name(camera.name + ".rgb")) throw UsageError("--camera: not a usable field name");
+  // The name prefixes the records' fields (NAME.rgb): empty or dotted, it would name other fields.
+  if (camera.name.empty() || camera.name.find('.') != std::string::npos || !stream::is_valid_field_name(camera.name))
+    throw UsageError("--camera: '" + camera.name + "' is not a camera name, expected letters, digits, '_' or '-'");
   if (args.has("intrinsics")) camera.intrinsics = intrinsics_from_values(args.reals("intrinsics", 4), "intrinsics");
   if (args.has("camera-pose") == args.has("extrinsics"))
     throw UsageError("give the camera's pose: one of --camera-pose and --extrinsics");

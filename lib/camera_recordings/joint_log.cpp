@@ -4,8 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
-
+#include "common/bounded_file.hpp"
 #include "common/error.hpp"
 
 namespace qte::camera_recordings {
@@ -90,15 +89,15 @@ void check_increasing(const std::string& path, const std::vector<NumberRow>& row
 
 std::vector<NumberRow> read_number_rows(const std::string& path, const std::vector<std::size_t>& column_counts,
                                         const std::string& columns, const std::string& rows) {
-  std::ifstream in(path);
-  if (!in) throw_system_error("cannot open " + path);
+  BoundedLines in(path, kNumberRowLimitBytes, kNumberFileLimitBytes, rows + " (" + columns + ")");
   std::string counts;
   for (std::size_t i = 0; i < column_counts.size(); ++i)
     counts += (i == 0 ? "" : i + 1 == column_counts.size() ? " or " : ", ") + std::to_string(column_counts[i]);
   std::vector<NumberRow> out;
   std::string line;
-  for (int number = 1; std::getline(in, line); ++number) {
-    if (line.empty() || line == "\r" || line[0] == '#') continue;
+  while (in.next(line)) {
+    const int number = in.line_number();
+    if (line.empty() || line[0] == '#') continue;
     const std::vector<std::string> cells = cells_of(line);
     NumberRow row{number, std::vector<double>(cells.size())};
     std::vector<Cell> kinds(cells.size());
@@ -118,7 +117,6 @@ std::vector<NumberRow> read_number_rows(const std::string& path, const std::vect
                   ")");
     out.push_back(std::move(row));
   }
-  if (in.bad()) throw_system_error("cannot read " + path);
   if (out.empty()) throw Error(path + ": no rows, expected " + rows + " (" + columns + ")");
   return out;
 }

@@ -17,6 +17,11 @@ struct NumberRow {
   std::vector<double> values;
 };
 
+// The most read of a CSV of numbers (a joint log, frame times): a line, and the whole file (a
+// joint log of 1 kHz for hours fits).
+constexpr std::size_t kNumberRowLimitBytes = 4096;
+constexpr uint64_t kNumberFileLimitBytes = uint64_t(1) << 30;
+
 // The rows of a CSV file of numbers, by the rules of every table obs-pack reads: a first line
 // with no number in it is a header, empty lines and lines starting with '#' are skipped, every
 // cell must be a finite number (nan and inf read as numbers: a row of them is data, and

@@ -15,6 +15,7 @@
 
 #include "cli/build_commit.hpp"
 #include "common/error.hpp"
+#include "common/standard_streams.hpp"
 #include "common/number_list.hpp"
 
 #ifndef QTE_VERSION
@@ -400,6 +401,7 @@ int run_tool(int argc, char** argv, const Usage& usage,
   // Likewise EFBIG for the file-size limit (SIGXFSZ would kill the process half-way through a
   // record): the writers then cut back what they wrote, as for a full disk.
   ::signal(SIGXFSZ, SIG_IGN);
+  reopen_closed_standard_streams();
   const std::string prefix = usage.name + ": ";
   try {
     const Arguments args = parse(usage, std::vector<std::string>(argv + 1, argv + argc));

@@ -11,9 +11,6 @@ namespace {
 // The spheres over-cover the links: two spheres of links that may not touch collide only when
 // they overlap by more than this.
 constexpr double kSelfCollisionMargin_m = 0.01;
-// For the same reason a sphere may reach this far into the table top while its link does not
-// (grasps of low objects bring the finger spheres there).
-constexpr double kTableTolerance_m = 0.005;
 
 }  // namespace
 
@@ -26,7 +23,7 @@ bool CollisionChecker::state_valid(const robot::JointVector& q, double opening_m
   spheres_.place(q, opening_m, world_from_base_, placed);
   if (spheres_.self_collision(placed, kSelfCollisionMargin_m)) return false;
   for (const Sphere& s : placed)  // the base link (0) stands on the table
-    if (s.link != 0 && s.centre.z() - s.radius_m < options_.table_height_m - kTableTolerance_m) return false;
+    if (s.link != 0 && s.centre.z() - s.radius_m < options_.table_height_m - kSphereOvercover_m) return false;
   return !scene || !scene->collides(placed, options_.clearance_m);
 }
 

@@ -14,6 +14,10 @@
 
 namespace qte::planning {
 
+// The spheres over-cover the links, so a sphere may reach this far into the table top (or out of
+// a workspace box) while its link does not: grasps of low objects bring the finger spheres there.
+constexpr double kSphereOvercover_m = 0.005;
+
 struct CollisionCheckOptions {
   double clearance_m = 0.0;      // extra distance kept from occupied voxels
   double check_step_rad = 0.02;  // motions are checked at least every this much of any joint

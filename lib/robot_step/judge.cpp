@@ -7,10 +7,11 @@
 
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 
 #include "common/atomic_file.hpp"
+#include "common/bounded_file.hpp"
 #include "common/error.hpp"
+#include "robot_step/spool.hpp"
 
 namespace qte::robot_step {
 
@@ -22,7 +23,7 @@ Verdict parse_verdict(const std::string& line, const std::string& what) {
   const std::string rest = space == std::string::npos ? "" : text.substr(text.find_first_not_of(' ', space));
   Verdict verdict;
   if (word == "success") verdict.outcome = Outcome::success;
-  else if (word == "failure") verdict.outcome = Outcome::failure, verdict.reason = rest.empty() ? "judged_failure" : rest;
+  else if (word == "failure") verdict.outcome = Outcome::failure, verdict.reason = rest.empty() ? "judged_failure" : clean_text(rest, kFaultTextLimitBytes);
   else if (word == "continue") verdict.outcome = Outcome::go_on;
   else throw Error(what + ": expected success, failure [reason] or continue, got '" + text.substr(0, 80) + "'");
   return verdict;
@@ -103,26 +104,23 @@ class PersonJudge : public Judge {
 
 class FileJudge : public Judge {
  public:
-  explicit FileJudge(std::string path) : path_(std::move(path)), in_(path_) {
-    if (!in_) throw Error(path_ + ": cannot be read (--outcomes)");
-  }
+  // A file or a FIFO (a script's outcomes as they come), read a bounded line at a time.
+  explicit FileJudge(const std::string& path)
+      : lines_(path, kJudgeLineLimitBytes, kOutcomesFileLimitBytes, "outcomes (--outcomes)") {}
   void reset(const EpisodeInfo&) override {}
   Verdict judge(const StepInfo& s) override {
     std::string line;
-    while (std::getline(in_, line)) {
-      line_ += 1;
+    while (lines_.next(line)) {
       const std::size_t first = line.find_first_not_of(" \t\r");
       if (first == std::string::npos || line[first] == '#') continue;
-      return parse_verdict(line.substr(first), path_ + ": line " + std::to_string(line_));
+      return parse_verdict(line.substr(first), lines_.path() + ": line " + std::to_string(lines_.line_number()));
     }
-    throw Error(path_ + ": no outcome left for step " + std::to_string(s.step) + " of episode " +
-                std::to_string(s.episode.episode) + " (after line " + std::to_string(line_) + ")");
+    throw Error(lines_.path() + ": no outcome left for step " + std::to_string(s.step) + " of episode " +
+                std::to_string(s.episode.episode) + " (after line " + std::to_string(lines_.line_number()) + ")");
   }
 
  private:
-  std::string path_;
-  std::ifstream in_;
-  int line_ = 0;
+  BoundedLines lines_;
 };
 
 class CommandJudge : public Judge {
@@ -160,8 +158,13 @@ class CommandJudge : public Judge {
     std::string out;
     char buffer[4096];
     std::size_t n;
-    while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) out.append(buffer, n);
+    while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0 && out.size() <= kJudgeOutputLimitBytes)
+      out.append(buffer, n);
+    // Closing our end first: a judge still printing gets EPIPE and ends.
     const int status = ::pclose(pipe);
+    if (out.size() > kJudgeOutputLimitBytes)
+      throw Error("the judge command '" + line + "' printed more than " + std::to_string(kJudgeOutputLimitBytes / 1024) +
+                  " KiB, expected one line: success, failure [reason] or continue");
     if (status == -1 || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
       throw Error("the judge command '" + line + "' failed (" +
                   (WIFSIGNALED(status) ? "signal " + std::to_string(WTERMSIG(status))

@@ -9,6 +9,12 @@
 
 namespace qte::robot_step {
 
+// What is read of a judge at most: a line of an outcomes file or of a command's output, an
+// outcomes file, a command's output (formats/robot-spool.md).
+constexpr std::size_t kJudgeLineLimitBytes = 4096;
+constexpr uint64_t kOutcomesFileLimitBytes = 16u << 20;
+constexpr std::size_t kJudgeOutputLimitBytes = 64 * 1024;
+
 struct EpisodeInfo {
   std::string task;
   int variation = 0;

@@ -6,6 +6,7 @@
 
 #include "camera_recordings/png_frames.hpp"
 #include "common/error.hpp"
+#include "planning/collision_checker.hpp"
 #include "robot/joint_path.hpp"
 #include "tasks/task.hpp"
 #include "world/scene_layout.hpp"
@@ -15,6 +16,14 @@ namespace qte::robot_step {
 namespace {
 
 constexpr double kStartTolerance_rad = 1e-3;  // a motion must start where the arm is (sim-step's)
+constexpr double kJointLimitSlack_deg = 1.0;  // a reported joint past its limit by more is a lie
+constexpr double kHomeCheckStep_rad = 0.02;   // the move to the start pose, checked this finely
+
+std::string point_text(const Eigen::Vector3d& p) {
+  char text[96];
+  std::snprintf(text, sizeof text, "(%.3f, %.3f, %.3f)", p.x(), p.y(), p.z());
+  return text;
+}
 
 std::string degrees_text(const robot::JointVector& degrees) {
   std::string out;
@@ -44,6 +53,7 @@ double time_stretch(const double* time_s, const double* joints, int64_t n, const
 
 RobotWorld::RobotWorld(const robot::RobotModel& robot, RobotOptions options, Spool& spool, Judge& judge)
     : robot_(robot),
+      spheres_(robot),
       options_(std::move(options)),
       spool_(spool),
       judge_(judge),
@@ -51,6 +61,28 @@ RobotWorld::RobotWorld(const robot::RobotModel& robot, RobotOptions options, Spo
   const std::string home = robot::joint_path_failure(std::vector<double>{0.0}.data(), options_.home.data(), 1, robot_);
   if (!home.empty()) throw UsageError("--home: " + home);
   gripper_m_ = robot_.max_finger_opening_m();
+  const std::string outside = arm_outside(options_.home, gripper_m_);
+  if (!outside.empty())
+    throw UsageError("--home, --workspace: at the start pose the arm's " + outside +
+                     " is outside the workspace or in the table");
+}
+
+std::string RobotWorld::arm_outside(const robot::JointVector& q, double opening_m) const {
+  const Eigen::Vector3d tool = (world_from_base_ * robot_.tcp_pose(q)).translation();
+  if (!options_.workspace.contains(tool)) return "gripper at " + point_text(tool);
+  thread_local std::vector<planning::Sphere> placed;
+  spheres_.place(q, opening_m, world_from_base_, placed);
+  const double table_z = world::SceneLayout::kTableHeight_m;
+  for (const planning::Sphere& s : placed) {
+    if (s.link == 0) continue;  // the base stands on the table, where the arm is mounted
+    // Inside: the sphere, shrunk by what spheres over-cover, in the box and above the table.
+    const double r = std::max(0.0, s.radius_m - planning::kSphereOvercover_m);
+    const Eigen::Vector3d reach = Eigen::Vector3d::Constant(r);
+    const bool inside = options_.workspace.contains(s.centre - reach) && options_.workspace.contains(s.centre + reach) &&
+                        s.centre.z() - r >= table_z;
+    if (!inside) return robot_.links()[s.link].name + " at " + point_text(s.centre);
+  }
+  return "";
 }
 
 void RobotWorld::handle(const stream::Record& record, const stream::Emit& emit) {
@@ -71,10 +103,35 @@ std::string RobotWorld::send(const std::vector<robot::XarmRow>& rows, const std:
     const std::string comment = "# robot-step: " + what + "\n";
     const MotionAnswer answer = spool_.move(rows, comment);
     last_motion_ = spool_.last_request();
-    if (!answer.done) return answer.fault;
+    if (!answer.done) {
+      joints_known_ = false;  // the arm stopped somewhere the driver did not say
+      return answer.fault;
+    }
     reached = answer.degrees, gripper = answer.gripper;
+    // An answer no arm could give stops the robot: the driver cannot be trusted further.
+    const robot::JointVector lower = robot_.lower_limits() * (180.0 / M_PI), upper = robot_.upper_limits() * (180.0 / M_PI);
+    for (int k = 0; k < robot::kArmJoints; ++k)
+      if (!(reached[k] >= lower[k] - kJointLimitSlack_deg && reached[k] <= upper[k] + kJointLimitSlack_deg)) {
+        const std::string why = spool_.directory() + "/" + last_motion_ + ".done: joint " + std::to_string(k + 1) +
+                                " reported at " + std::to_string(reached[k]) + " deg, outside its limits " +
+                                std::to_string(lower[k]) + " to " + std::to_string(upper[k]) +
+                                " deg: the driver's answer cannot be right";
+        spool_.stop("robot-step stopped: " + why);
+        throw Error(why + " (stop written)");
+      }
+    joints_known_ = true;
+    const double off = (reached - last.degrees).cwiseAbs().maxCoeff();
+    if (off > options_.reach_tolerance_deg) {
+      joints_ = reached * (M_PI / 180.0);  // the arm is where the driver says, not where it was sent
+      gripper_m_ = gripper / robot::kXarmGripperOpenUnits * robot_.max_finger_opening_m();
+      char tolerance[32];
+      std::snprintf(tolerance, sizeof tolerance, "%g", options_.reach_tolerance_deg);
+      return "reached " + degrees_text(reached) + " deg, not the commanded " + degrees_text(last.degrees) +
+             " deg (more than " + tolerance + " deg away)";
+    }
   }
   joints_ = reached * (M_PI / 180.0);
+  joints_known_ = true;
   gripper_m_ = gripper / robot::kXarmGripperOpenUnits * robot_.max_finger_opening_m();
   return "";
 }
@@ -130,6 +187,19 @@ void RobotWorld::reset(const stream::Record& record, const stream::Emit& emit) {
   robot::XarmRow home;
   home.degrees = options_.home * (180.0 / M_PI);
   home.gripper = static_cast<int>(robot::kXarmGripperOpenUnits);
+  // The driver reaches a one-row motion in joint space along the straight line from where the
+  // arm is: checked like any motion once a driver has said where that is.
+  if (joints_known_) {
+    const int steps =
+        std::max(1, static_cast<int>(std::ceil((options_.home - joints_).cwiseAbs().maxCoeff() / kHomeCheckStep_rad)));
+    for (int i = 0; i <= steps; ++i) {
+      const std::string outside =
+          arm_outside(joints_ + (options_.home - joints_) * (static_cast<double>(i) / steps), gripper_m_);
+      if (!outside.empty())
+        throw Error("the move to the start pose (--home) would take the arm's " + outside +
+                    " outside the workspace or into the table: not sent; move the arm by hand, then run again");
+    }
+  }
   const std::string fault = send({home}, episode_.task + " episode " + std::to_string(episode_.episode) + ": start pose");
   if (!fault.empty()) throw Error("the arm driver could not reach the start pose: " + fault);
   step_ = frame_ = 0;
@@ -168,12 +238,12 @@ std::string RobotWorld::check_motion(const stream::Record& record, std::vector<r
     return longer;
   }
   for (const robot::XarmRow& row : rows) {
-    const Eigen::Vector3d p = (world_from_base_ * robot_.tcp_pose(row.degrees * (M_PI / 180.0))).translation();
-    if (!options_.workspace.contains(p)) {
-      char where[160];
-      std::snprintf(where, sizeof where, "workspace:gripper at (%.3f, %.3f, %.3f) at %.2f s", p.x(), p.y(), p.z(),
-                    row.time_s);
-      return where;
+    const double opening_m = row.gripper / robot::kXarmGripperOpenUnits * robot_.max_finger_opening_m();
+    const std::string outside = arm_outside(row.degrees * (M_PI / 180.0), opening_m);
+    if (!outside.empty()) {
+      char at[48];
+      std::snprintf(at, sizeof at, " at %.2f s", row.time_s);
+      return "workspace:" + outside + at;
     }
   }
   return "";

@@ -1,8 +1,10 @@
 // The real robot as an episode stage, what robot-step runs: 'reset' and 'trajectory' records in,
 // 'obs' records out, as the simulator does, with the arm and camera behind a spool and a judge
 // for the reward. Every motion is checked before it is handed over: joint limits, joint speeds,
-// a start where the arm is, and the gripper inside the workspace along the whole path; a motion
-// that fails a check is never sent, and ends the episode as an invalid action does in sim-step.
+// a start where the arm is, and the whole arm (every link and both fingers) inside the
+// workspace and above the table along the whole path, the move to the start pose included; a
+// motion that fails a check is never sent, and ends the episode as an invalid action does in
+// sim-step. Every answer of the driver is checked before it enters an observation.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -10,6 +12,7 @@
 #include <string>
 
 #include "camera_recordings/camera_recordings.hpp"
+#include "planning/robot_spheres.hpp"
 #include "robot/robot_model.hpp"
 #include "robot_step/judge.hpp"
 #include "robot_step/spool.hpp"
@@ -21,8 +24,12 @@ namespace qte::robot_step {
 struct RobotOptions {
   camera_recordings::CameraSetup camera;
   robot::JointVector home = world::SceneLayout::ready_joints();  // rad: the simulation's start pose
-  // Where the gripper's tool point may go (world frame): the scene above the table top.
-  Eigen::AlignedBox3d workspace{Eigen::Vector3d(-0.3, -0.5, 0.752), Eigen::Vector3d(0.7, 0.5, 1.6)};
+  // Where the arm may go (world frame): every link's collision spheres but the base's, and the
+  // gripper's tool point, stay in this box, which holds the arm at its start pose; its floor
+  // is the table top.
+  Eigen::AlignedBox3d workspace{Eigen::Vector3d(-0.65, -0.5, 0.752), Eigen::Vector3d(0.7, 0.5, 1.6)};
+  // A driver's reached joints further than this from the motion's last row are a fault.
+  double reach_tolerance_deg = 2.0;
   double speed_fraction = 1.0;  // of each joint's speed limit; slower motions are stretched in time
   double rate_hz = 100, settle_s = 0.5;  // the rows the driver streams (xarm-export's)
   int episode_length = 10;
@@ -47,10 +54,14 @@ class RobotWorld : public sim_step::EpisodeStage {
   // The motion's rows, or why it must not be sent (an observation's failure reason).
   std::string check_motion(const stream::Record& record, std::vector<robot::XarmRow>& rows) const;
   std::string send(const std::vector<robot::XarmRow>& rows, const std::string& what);  // "" or the fault
+  // Where the arm at q (the fingers `opening_m` apart) leaves the workspace or touches the
+  // table: "<link> at (x, y, z)", or "" when it is inside.
+  std::string arm_outside(const robot::JointVector& q, double opening_m) const;
   stream::Record observe();  // a frame from the camera and the arm's state
   void set_episode_fields(stream::Record& obs, const std::string& failure);
 
   const robot::RobotModel& robot_;
+  planning::RobotSpheres spheres_;
   RobotOptions options_;
   Spool& spool_;
   Judge& judge_;
@@ -58,6 +69,7 @@ class RobotWorld : public sim_step::EpisodeStage {
   EpisodeInfo episode_;
   int episodes_ = 0;
   robot::JointVector joints_ = robot::JointVector::Zero();
+  bool joints_known_ = false;  // a driver has reported where the arm is
   double gripper_m_ = 0;
   bool started_ = false;
   int step_ = 0;

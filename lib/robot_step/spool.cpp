@@ -2,11 +2,10 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <thread>
 
 #include "common/atomic_file.hpp"
+#include "common/bounded_file.hpp"
 #include "common/error.hpp"
 #include "common/number_list.hpp"
 
@@ -16,18 +15,26 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string read_all(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot be read");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+std::string read_answer(const std::string& path) { return read_regular_file(path, kAnswerLimitBytes, "a driver's answer"); }
 
 std::string first_line(const std::string& text) {
   std::string line = text.substr(0, text.find('\n'));
   while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
   return line;
+}
+
+// A fault's words as they go into an observation's string: valid UTF-8, one line, bounded.
+std::string fault_text(const std::string& answer, const char* silent) {
+  const std::string line = clean_text(first_line(answer), kFaultTextLimitBytes);
+  return line.empty() ? silent : line;
+}
+
+// A frame is read only from regular files: a FIFO or a device named as one would never end.
+void require_frame_file(const std::string& path) {
+  std::error_code error;
+  if (!fs::is_regular_file(path, error))
+    throw Error(path + ": " + (fs::exists(path, error) ? "not a regular file" : "missing") +
+                ", expected the recorder's PNG beside its .ready answer");
 }
 
 }  // namespace
@@ -130,12 +137,11 @@ MotionAnswer Spool::move(const std::vector<robot::XarmRow>& rows, const std::str
   const RemovedOnSignal pending(path(name + ".xarm.csv"));
   return stopping_on_error([&] {
     write_file_atomically(path(name + ".xarm.csv"), csv.data(), csv.size());
-    const std::size_t which = wait_for({name + ".done", name + ".fault"}, motion_timeout_, path(name + ".xarm.csv"));
-    const std::string answer = path(name + (which == 0 ? ".done" : ".fault"));
-    if (which == 0) return parse_done(read_all(answer), answer);
+    wait_for({name + ".done", name + ".fault"}, motion_timeout_, path(name + ".xarm.csv"));
+    // A fault wins over any other answer to the same request: the driver knows better.
+    if (!fs::exists(path(name + ".fault"))) return parse_done(read_answer(path(name + ".done")), path(name + ".done"));
     MotionAnswer fault;
-    fault.fault = first_line(read_all(answer));
-    if (fault.fault.empty()) fault.fault = "the driver reported a fault without saying which";
+    fault.fault = fault_text(read_answer(path(name + ".fault")), "the driver reported a fault without saying which");
     return fault;
   });
 }
@@ -145,15 +151,16 @@ CaptureAnswer Spool::capture() {
   const RemovedOnSignal pending(path(name + ".request"));
   return stopping_on_error([&] {
     write_file_atomically(path(name + ".request"), "", 0);
-    const std::size_t which = wait_for({name + ".ready", name + ".fault"}, capture_timeout_, path(name + ".request"));
+    wait_for({name + ".ready", name + ".fault"}, capture_timeout_, path(name + ".request"));
     CaptureAnswer answer;
-    if (which == 1) {
-      answer.fault = first_line(read_all(path(name + ".fault")));
-      if (answer.fault.empty()) answer.fault = "the recorder reported a fault without saying which";
+    if (fs::exists(path(name + ".fault"))) {
+      answer.fault = fault_text(read_answer(path(name + ".fault")), "the recorder reported a fault without saying which");
       return answer;
     }
     answer.colour_png = path(name + ".color.png");
     answer.depth_png = path(name + ".depth.png");
+    require_frame_file(answer.colour_png);
+    require_frame_file(answer.depth_png);
     return answer;
   });
 }

@@ -13,6 +13,11 @@
 
 namespace qte::robot_step {
 
+// What is read of a driver's or recorder's answer file at most (formats/robot-spool.md): a
+// .done is one line of eight numbers; a fault's words go into an observation cut to the second.
+constexpr std::size_t kAnswerLimitBytes = 64 * 1024;
+constexpr std::size_t kFaultTextLimitBytes = 200;
+
 // What the arm driver reported at the end of a motion.
 struct MotionAnswer {
   bool done = false;

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "common/standard_streams.hpp"
 #include "stream/codec.hpp"
 
 namespace qte::stream {
@@ -54,6 +55,8 @@ std::unique_ptr<ByteSource> open_path(const std::string& path) {
     // A person at a terminal, not a pipe: waiting for a binary stream typed by hand helps nobody.
     if (::isatty(0))
       throw UsageError("standard input is a terminal: give the input file, or pipe a record stream in");
+    if (standard_input_was_closed())
+      throw UsageError("standard input is closed: give the input file, or pipe a record stream in");
     return std::make_unique<FdSource>(0, false, "<stdin>");
   }
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);

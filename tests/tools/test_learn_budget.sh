@@ -3,7 +3,7 @@
 # run has taken follow from its environment steps and the replay ratio, whatever the machine's
 # load), one actor pipeline (one qte-select, one LibTorch start) serves the whole run, the CSV
 # splits the processor time by role, and a learner that dies stops the run at once with a line
-# naming it; the run then resumes to its end, its processor and wall-clock accounts kept across
+# naming it, as does a learner that stops making progress (STALL_SECONDS); the run then resumes to its end, its processor and wall-clock accounts kept across
 # the kill (saved while it waits, ACCOUNT_EVERY seconds apart, not only before evaluations).
 source "$(dirname "$0")/common.sh"
 learn=${QTE_SOURCE:?}/examples/learn.sh
@@ -93,4 +93,24 @@ awk "BEGIN { exit !($sum - $(column cpu_s) > -1.5 && $sum - $(column cpu_s) < 1.
 for role in demos pretrain learner actor; do
   awk "BEGIN { exit !($(column "cpu_${role}_s") > 0) }" || fail "no processor time for the role $role: $final"
 done
+
+# 3. A learner alive but stuck (stopped here with SIGSTOP) while the actor waits for it stops
+# the run within STALL_SECONDS, with a line naming it; nothing of the run is left running.
+stuck=$tmp/stuck
+STALL_SECONDS=5 bash "$learn" reach_target "$stuck" 2> "$tmp/stuck.log" &
+stuck_pid=$!
+for _ in $(seq 1 3000); do
+  [ -f "$stuck/ckpt/latest.rec" ] && break
+  kill -0 $stuck_pid 2>/dev/null || fail "learn.sh (stuck) ended early: $(tail -5 "$tmp/stuck.log")"
+  sleep 0.1
+done
+stuck_learner=$(pgrep -f "qattn-train --follow .*$stuck/replay.rec") || fail "no learner (stuck)"
+kill -STOP "$stuck_learner"
+for _ in $(seq 1 600); do kill -0 $stuck_pid 2>/dev/null || break; sleep 0.1; done
+kill -0 $stuck_pid 2>/dev/null && { kill -CONT "$stuck_learner"; fail "learn.sh still waiting 60 s after its learner stopped"; }
+wait $stuck_pid && fail "learn.sh exited 0 with a stuck learner"
+grep -q "the learner (qattn-train, pid $stuck_learner) made no progress in 5 s" "$tmp/stuck.log" \
+  || fail "no line naming the stuck learner: $(tail -3 "$tmp/stuck.log")"
+sleep 1
+pgrep -f "$stuck" > /dev/null && fail "programs of the stuck run still running: $(pgrep -af "$stuck")"
 echo "ok: learner step $step after $env_steps environment steps (allowed $low..$high); cpu $(column cpu_s) s"

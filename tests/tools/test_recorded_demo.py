@@ -208,6 +208,9 @@ cases = [
     ([p("half_open.csv"), times], 1, "half_open.csv: line 4: column 10 is 0.500000, expected 1 (gripper open) or 0"),
     ([log, p("late_frames.csv")], 1, "late_frames.csv: line 1: frame time 1334.5 s is outside the joint log"),
     ([log, p("more_frames.csv")], 1, "no such frame"),
+    # Endless inputs are bounded: a line of a joint log or of frame times is at most 4 KiB.
+    (["/dev/zero", times], 1, "/dev/zero: line 1 is longer than 4 KiB"),
+    ([log, "/dev/zero"], 1, "/dev/zero: line 1 is longer than 4 KiB"),
 ]
 with open(p("kept.rec"), "wb") as f:
     f.write(open(p("once.rec"), "rb").read())

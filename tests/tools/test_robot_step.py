@@ -28,7 +28,19 @@ rendered copied for every capture, nothing answered once `stop` exists):
 7. --dry-run: no motion file at all, one "dry run, not sent" line per motion, captures still
    requested, observations at the path's last waypoint;
 8. a judge saying "maybe" (or such a line in --outcomes): exit 1, one line naming the command
-   (the file and line) and what was expected.
+   (the file and line) and what was expected;
+9. an answer robot-step cannot read (a gripper past open), --settle 0;
+10. a driver never trusted: an answer that is a FIFO, a link to /dev/zero or larger than 64 KiB
+   (a .done or a fault line) is one line and exit 1 within --motion-timeout; reached joints at
+   1e308 deg or past a joint's limit stop the robot; reached joints 5 deg from the motion sent
+   end the episode as a driver fault naming both; a fault beside a .done (or a recorder's
+   .ready) wins; fault text that is not UTF-8 goes into the observation made valid and cut to
+   200 bytes;
+11. bounded judges and inputs: --outcomes /dev/zero or a directory, a judge command printing
+   without end, standard input closed, --workspace of 1e300: one line each, in time;
+12. the whole arm: a motion whose tool point stays inside --workspace but whose upper arm leaves
+   it is refused before it is written; a --home outside the box is a usage error; a move back
+   to the start pose through the table (from where the driver said the arm went) is never sent.
 
 Assertions marked "BUG" are behaviour the spool format requires that robot-step did not have
 when this test was written (see the commit message of this file).
@@ -453,14 +465,23 @@ if check(len(refused.obs) == 8, f"refused: {len(refused.obs)} observations, expe
         check(got.startswith(reason) and (scalar(o, "reward"), scalar(o, "terminal")) == (0, 1),
               f"refused: failure {got!r} terminal {scalar(o, 'terminal')}, expected {reason!r}, terminal")
         check(np.allclose(o.fields["joint_positions"], READY, atol=1e-7), f"refused: the arm moved for {reason}")
-    m = re.fullmatch(r"workspace:gripper at \((-?[\d.]+), (-?[\d.]+), (-?[\d.]+)\) at ([\d.]+) s",
+    # The first place the arm leaves the box or meets the table: the tool point, or a finger's
+    # collision sphere (which reaches lower), named with where it is and when.
+    m = re.fullmatch(r"workspace:(\w+) at \((-?[\d.]+), (-?[\d.]+), (-?[\d.]+)\) at ([\d.]+) s",
                      refused.obs[3].fields.get("failure", ""))
     if check(m, f"refused: workspace failure {refused.obs[3].fields.get('failure')!r}: "
-                "not 'workspace:gripper at (x, y, z) at T s'"):
-        x, y, z, t = map(float, m.groups())
+                "not 'workspace:<link> at (x, y, z) at T s'"):
+        link = m.group(1)
+        x, y, z, t = map(float, m.groups()[1:])
         q = np.interp(t, [0, 1, 2], [0, 0.8, 0]) * np.array([0, 1, 0, 0, 0, 0, 0]) + READY
-        check(z < TABLE_TOP_Z and np.allclose(tool_point(q), [x, y, z], atol=2e-3),
-              f"refused: the workspace failure says the gripper is at {(x, y, z)} at {t} s; it is at {tool_point(q)}")
+        if link == "gripper":
+            check(z < TABLE_TOP_Z and np.allclose(tool_point(q), [x, y, z], atol=2e-3),
+                  f"refused: the workspace failure says the gripper is at {(x, y, z)} at {t} s; it is at {tool_point(q)}")
+        else:
+            check(link in ("left_finger", "right_finger") and z < TABLE_TOP_Z + 0.03
+                  and np.linalg.norm(tool_point(q) - [x, y, z]) < 0.08 and tool_point(q)[2] > TABLE_TOP_Z - 0.01,
+                  f"refused: the workspace failure names {link} at {(x, y, z)} at {t} s: expected a finger reaching the "
+                  f"table before the tool point {tool_point(q)} does")
 
 # --speed 0.1: a path at 1 rad/s on joint 1 (0.32 of its limit) is stretched by 1 / (0.1 pi).
 fast_end = READY + [0.5, 0, 0, 0.3, 0, 0, 0]
@@ -740,6 +761,196 @@ settle = subprocess.run([os.path.join(TOOLS, "robot-step"), "--spool", p("spool_
                         input=b"", capture_output=True)
 check(settle.returncode == 2 and b"--settle" in settle.stderr,
       f"--settle 0 (a gripper row at the motion's last time, which drivers refuse): exit {settle.returncode}, {settle.stderr!r}")
+
+# === 10. a driver never trusted ==========================================================================
+class OddDriver(FakeRobot):
+    """A driver whose answer to the step's motion (request 2) is made by `answer(spool, stem)`."""
+
+    def __init__(self, spool, answer):
+        self.answer = answer
+        super().__init__(spool)
+
+    def motion(self, n, stem, text):
+        if n == 2:
+            self.motions[n] = read_motion(text)
+            self.answer(self.spool, stem)
+        else:
+            super().motion(n, stem, text)
+
+
+def fifo_answer(spool, stem):
+    os.mkfifo(os.path.join(spool, stem + ".done"))
+
+
+def zero_answer(spool, stem):
+    os.symlink("/dev/zero", os.path.join(spool, stem + ".done"))
+
+
+def huge_answer(spool, stem):  # 300 MB, sparse: written in no time
+    with open(os.path.join(spool, "." + stem), "wb") as f:
+        f.truncate(300 << 20)
+    os.replace(os.path.join(spool, "." + stem), os.path.join(spool, stem + ".done"))
+
+
+def huge_fault(spool, stem):  # one line of 200 MB
+    with open(os.path.join(spool, "." + stem), "wb") as f:
+        f.write(b"x" * (200 << 20))
+    os.replace(os.path.join(spool, "." + stem), os.path.join(spool, stem + ".fault"))
+
+
+def lie(degrees):
+    return lambda spool, stem: put(spool, stem + ".done", ",".join(str(d) for d in degrees) + ",850\n")
+
+
+def fault_and_done(spool, stem):
+    """Both answers at once: the arm faulted, and a confused driver also said done."""
+    put(spool, "." + stem + ".f", "collision detected\n")
+    put(spool, "." + stem + ".d", ",".join(f"{d:.6f}" for d in np.degrees(READY + [0.2, 0, 0, 0, 0, 0, 0])) + ",850\n")
+    os.replace(os.path.join(spool, "." + stem + ".d"), os.path.join(spool, stem + ".done"))
+    os.replace(os.path.join(spool, "." + stem + ".f"), os.path.join(spool, stem + ".fault"))
+
+
+def odd_run(case, answer, outcomes=("continue",)):
+    spool = p("spool_" + case)
+    robot = OddDriver(spool, answer)
+    r = RobotStep(case, spool, [reset_record, *steps], "--motion-timeout", 20,
+                  "--outcomes", outcomes_file(case + ".txt", *outcomes))
+    t = time.monotonic()
+    r.end(timeout=40)
+    r.took = time.monotonic() - t
+    robot.end()
+    return r, spool
+
+
+for case, answer, words in (("answer_fifo", fifo_answer, "a FIFO, expected a regular file"),
+                            ("answer_zero", zero_answer, "a device, expected a regular file"),
+                            ("answer_huge", huge_answer, "larger than 64 KiB"),
+                            ("fault_huge", huge_fault, "larger than 64 KiB"),
+                            ("answer_1e308", lie([0, -20, 0, 1e308, 0, 63, 0]), "joint 4 reported at"),
+                            ("answer_past_limit", lie([0, -20, 0, 250, 0, 63, 0]), "outside its limits")):
+    r, spool = odd_run(case, answer)
+    r.expect_exit(1, f"a driver's answer {case}")
+    line = r.error_line()
+    check(words in line and r.request("motion", 2) in line,
+          f"{case}: the error line {line!r} does not name the answer file and say {words!r}")
+    check(r.took < 15, f"{case}: robot-step took {r.took:.1f} s (--motion-timeout 20): it must not wait on the answer")
+    check(os.path.exists(os.path.join(spool, "stop")), f"{case}: stop not written")
+    check(len(r.obs) == 1, f"{case}: {len(r.obs)} observations: the step's answer went into one")
+
+# Reached 5 deg away from the motion's end: a driver fault naming both poses, the episode over.
+target = np.degrees(READY + [0.2, 0, 0, 0, 0, 0, 0])
+astray, _ = odd_run("answer_astray", lie(target + [5, 0, 0, 0, 0, 0, 0]), outcomes=())
+astray.expect_exit(0, "reached 5 deg from the motion sent")
+if check(len(astray.obs) == 2, f"answer_astray: {len(astray.obs)} observations"):
+    failure = astray.obs[1].fields.get("failure", "")
+    check(failure.startswith("driver_fault:reached ") and f"{target[0] + 5:.1f}" in failure
+          and f"{target[0]:.1f}" in failure and "2 deg" in failure and scalar(astray.obs[1], "terminal") == 1,
+          f"answer_astray: failure {failure!r}: expected a driver fault with both poses and the 2 deg tolerance")
+    check(np.allclose(astray.obs[1].fields["joint_positions"], np.radians(target + [5, 0, 0, 0, 0, 0, 0]), atol=1e-6),
+          "answer_astray: the observation's joints are not where the driver says the arm is")
+
+both, _ = odd_run("fault_and_done", fault_and_done, outcomes=())
+both.expect_exit(0, "a .fault beside a .done")
+check(len(both.obs) == 2 and both.obs[1].fields.get("failure") == "driver_fault:collision detected",
+      f"fault_and_done: failure {both.obs[1].fields.get('failure') if len(both.obs) == 2 else len(both.obs)}: the fault must win")
+
+bad_text = b"gripper \xff\xfe jammed \xc3\x28 " + "\u00e9".encode() * 300
+mangled, _ = odd_run("fault_not_utf8", lambda spool, stem: put(spool, stem + ".fault", bad_text + b"\n"), outcomes=())
+mangled.expect_exit(0, "fault text that is not UTF-8")
+if check(len(mangled.obs) == 2, f"fault_not_utf8: {len(mangled.obs)} observations"):
+    failure = mangled.obs[1].fields.get("failure", "")
+    raw = failure.encode("utf-8", "surrogateescape")  # the reader keeps bytes that are not UTF-8 so
+    check(failure.startswith("driver_fault:gripper ?? jammed ?( ") and len(raw) <= len("driver_fault:") + 200
+          and raw.decode("utf-8", "replace") == failure and failure.endswith("\u00e9"),
+          f"fault_not_utf8: failure {failure[:60]!r}... ({len(raw)} bytes): expected the bad bytes as '?', "
+          "cut at a character to 200 bytes")
+
+
+class TwoAnswerRecorder(FakeRobot):
+    """A recorder that answers the step's capture (request 3) with both .ready and .fault."""
+
+    def capture(self, stem, request):
+        super().capture(stem, request)
+        if stem.endswith("-000003"):
+            put(self.spool, stem + ".fault", "camera unplugged\n")
+
+
+spool = p("spool_ready_and_fault")
+robot = TwoAnswerRecorder(spool)
+ready_fault = RobotStep("ready_and_fault", spool, [reset_record, *steps], "--outcomes", NO_OUTCOMES)
+ready_fault.end()
+robot.end()
+ready_fault.expect_exit(1, "a recorder's .fault beside its .ready")
+check("camera unplugged" in ready_fault.error_line(),
+      f"ready_and_fault: the error line {ready_fault.error_line()!r} does not give the recorder's fault")
+
+# === 11. bounded judges and inputs =======================================================================
+os.makedirs(p("outcomes_dir"))
+for case, options, words in (("outcomes_zero", ["--outcomes", "/dev/zero"], "/dev/zero: line 1 is longer than 4 KiB"),
+                             ("outcomes_dir", ["--outcomes", p("outcomes_dir")], "a directory"),
+                             ("judge_endless", ["--judge", "yes 2>/dev/null"], "printed more than 64 KiB")):
+    robot = FakeRobot(p("spool_" + case))
+    r = RobotStep(case, p("spool_" + case), [reset_record, *steps], *options)
+    r.end(timeout=20)
+    robot.end()
+    r.expect_exit(1, case)
+    check(words in r.error_line(), f"{case}: the error line {r.error_line()!r} does not say {words!r}")
+
+closed = subprocess.run([os.path.join(TOOLS, "robot-step"), "--spool", p("spool_closed"), *CAMERA,
+                         "--outcomes", outcomes_file("closed.txt", "continue")],
+                        stdin=subprocess.DEVNULL, capture_output=True, timeout=20,
+                        preexec_fn=lambda: os.close(0))
+check(closed.returncode == 2 and b"standard input is closed" in closed.stderr and not closed.stdout,
+      f"stdin closed: exit {closed.returncode}, {closed.stderr!r}: expected a usage error saying so "
+      "(not the outcomes file read as the record stream)")
+wide = subprocess.run([os.path.join(TOOLS, "robot-step"), "--spool", p("spool_wide"), *CAMERA,
+                       "--workspace", "-1e300,-1e300,-1e300,1e300,1e300,1e300"], input=b"", capture_output=True)
+check(wide.returncode == 2 and b"--workspace" in wide.stderr and b"10 m" in wide.stderr,
+      f"--workspace of 1e300: exit {wide.returncode}, {wide.stderr!r}")
+
+# === 12. the whole arm ======================================================================================
+# Joint 2 back and joint 4 bent: the tool point stays over the table, the upper arm (link3)
+# swings behind the base, past a box whose back wall is at x = -0.45.
+BOX = "-0.45,-0.5,0.752,0.7,0.5,1.6"
+lean = READY + [0, -0.3, 0, 0.3, 0, 0, 0]
+check(-0.45 < tool_point(lean)[0] < 0.7 and TABLE_TOP_Z < tool_point(lean)[2] < 1.6,
+      f"the test's leaning pose has its tool point {tool_point(lean)} outside the box")
+spool = p("spool_arm")
+robot = FakeRobot(spool)
+arm = RobotStep("arm", spool, [reset_record, trajectory([0, 1], [READY, lean])], "--workspace", BOX,
+                "--outcomes", NO_OUTCOMES)
+arm.end()
+robot.end()
+arm.expect_exit(0, "a motion whose upper arm leaves the box")
+check(motion_files(spool) == [arm.request("motion", 0) + ".xarm.csv"],
+      f"arm: motion files {motion_files(spool)}: the refused motion was written")
+if check(len(arm.obs) == 2, f"arm: {len(arm.obs)} observations"):
+    failure = arm.obs[1].fields.get("failure", "")
+    m = re.fullmatch(r"workspace:(link\d) at \((-?[\d.]+), (-?[\d.]+), (-?[\d.]+)\) at ([\d.]+) s", failure)
+    check(m and m.group(1) in ("link2", "link3", "link4") and float(m.group(2)) < -0.39,
+          f"arm: failure {failure!r}: expected an upper-arm link behind x = -0.45")
+
+narrow = subprocess.run([os.path.join(TOOLS, "robot-step"), "--spool", p("spool_narrow"), *CAMERA,
+                         "--workspace", "-0.35,-0.5,0.752,0.7,0.5,1.6", "--outcomes", NO_OUTCOMES],
+                        input=reset_record, capture_output=True)
+check(narrow.returncode == 2 and b"--home" in narrow.stderr and b"link" in narrow.stderr
+      and not os.listdir(p("spool_narrow")),
+      f"a --home whose arm is outside --workspace: exit {narrow.returncode}, {narrow.stderr!r}, spool "
+      f"{os.listdir(p('spool_narrow')) if os.path.isdir(p('spool_narrow')) else None}")
+
+# The driver says the step left the fingers in the table (a fault: 5 deg off); going home from
+# there along the joint-space line would drag them through it: the second reset sends nothing.
+low_deg = np.degrees(READY + [0, 0.75, 0, 0, 0, 0, 0])
+spool = p("spool_home")
+robot = OddDriver(spool, lie(low_deg))
+home = RobotStep("home", spool, [reset_record, *steps, reset_record], "--outcomes", NO_OUTCOMES)
+home.end()
+robot.end()
+home.expect_exit(1, "a move home through the table")
+check("start pose" in home.error_line() and "table" in home.error_line(),
+      f"home: the error line {home.error_line()!r} does not say the move to the start pose was refused")
+check(motion_files(spool) == [home.request("motion", n) + ".xarm.csv" for n in (0, 2)],
+      f"home: motion files {motion_files(spool)}: the move home through the table was written")
 
 if failures:
     print("\n".join("FAIL: " + f for f in failures))

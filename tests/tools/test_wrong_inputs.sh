@@ -79,4 +79,9 @@ refused "sim-step --variation 99" "--variation|0..19" "$tmp/v.rec" -- \
 ! grep -q "stdin" "$tmp/err" || fail "--variation 99 blamed standard input: $(cat "$tmp/err")"
 mkdir -p "$tmp/spool"
 refused "robot-step --judge ''" "--judge" "" -- robot-step --spool "$tmp/spool" --camera front --judge '' --output "$tmp/j.rec"
+for program in "robot-step --spool $tmp/spool --outcomes /dev/null --intrinsics 1,1,1,1" "obs-pack --pcd $tmp/x_%d.pcd"; do
+  refused "$program --camera ''" "--camera|'' is not a camera name" "$tmp/c.rec" -- \
+    $program --camera '' --camera-pose 0,0,0,0,0,0,1 --output "$tmp/c.rec"
+  ! grep -q "stdin" "$tmp/err" || fail "$program --camera '': blamed standard input: $(cat "$tmp/err")"
+done
 echo "wrong inputs named"
