@@ -4,7 +4,7 @@
 #include "cli/command.hpp"
 #include "keyframes/transitions.hpp"
 #include "stream/reader.hpp"
-#include "stream/stream_options.hpp"
+#include "cli/stream_options.hpp"
 #include "stream/writer.hpp"
 #include "voxels/hierarchy_options.hpp"
 
@@ -50,7 +50,7 @@ static cli::Usage usage() {
       {"not-demo", "", "mark the transitions as the agent's own, not demonstrations", ""},
       {"agent", "", "convert the agent's episodes (obs and action records) instead of demonstrations", ""},
   };
-  u.add_options(stream::append_options());
+  u.add_options(cli::append_options());
   u.options.push_back(cli::output_file());
   u.add_options(voxels::hierarchy_options());
   u.uses_randomness = true;
@@ -73,7 +73,7 @@ static void run(const cli::Arguments& args) {
   options.demo = !args.flag("not-demo");
   options.seed = args.seed();
 
-  const stream::WriteOptions write_options = stream::write_options_from(args, {args.input()});
+  const stream::WriteOptions write_options = cli::write_options_from(args, {args.input()});
   stream::RecordReader reader(args.input());
   stream::RecordWriter writer(args.text("output"), write_options);
   const auto convert_all = [&](auto&& converter) {

@@ -5,7 +5,7 @@
 #include "camera_recordings/recording.hpp"
 #include "cli/command.hpp"
 #include "robot/robot_model.hpp"
-#include "stream/stream_options.hpp"
+#include "cli/stream_options.hpp"
 #include "stream/writer.hpp"
 
 using namespace qte;
@@ -73,7 +73,7 @@ static cli::Usage usage() {
   };
   u.add_options(camera_recordings::camera_setup_options());
   u.options.push_back(cli::output_file());
-  u.add_options(stream::append_options());
+  u.add_options(cli::append_options());
   u.examples = {
       {"obs-pack --rgb rec/color_%06d.png --depth rec/depth_%06d.png --intrinsics 615.2,615.0,320.5,240.1 "
        "--camera-pose 1.05,0,1.602,-0.63365,-0.63365,0.31383,0.31383 --joints rec/joints.csv > real.rec",
@@ -123,7 +123,7 @@ static void run(const cli::Arguments& args) {
   std::vector<std::string> inputs;
   for (const char* file : {"joints", "joint-log", "frame-times"})
     if (args.has(file)) inputs.push_back(args.text(file));
-  const stream::WriteOptions write_options = stream::write_options_from(args, inputs);
+  const stream::WriteOptions write_options = cli::write_options_from(args, inputs);
   // An append is record by record: every frame is read and checked once before, so that a bad
   // one leaves the file as it was rather than half a demonstration in it.
   if (write_options.mode == stream::WriteMode::append && args.text("output") != "-")

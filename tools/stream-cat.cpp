@@ -5,7 +5,7 @@
 
 #include "cli/command.hpp"
 #include "stream/record_filter.hpp"
-#include "stream/stream_options.hpp"
+#include "cli/stream_options.hpp"
 
 using namespace qte;
 
@@ -29,9 +29,9 @@ static cli::Usage usage() {
       {"exclude", "T", "drop records of type T", "", true},
       {"where", "NAME=VALUE", "keep only records whose scalar or text field NAME equals VALUE (numbers compare as numbers)", "", true},
       {"head", "N", "stop after N records have been written; -1 for no limit", "-1"},
-      stream::max_record_bytes_option(),
+      cli::max_record_bytes_option(),
   };
-  u.add_options(stream::append_options());
+  u.add_options(cli::append_options());
   u.options.push_back(cli::output_file());
   u.examples = {
       {"stream-cat ep1.rec ep2.rec --output all.rec", "join two files into one (atomically)"},
@@ -51,8 +51,8 @@ static void run(const cli::Arguments& args) {
                                {drop.begin(), drop.end()},
                                args.assignments("where"),
                                args.integer("head", -1, 1000000000000000)});
-  const stream::ReadOptions read_options = stream::read_options_from(args);
-  const stream::WriteOptions write_options = stream::write_options_from(args, files);
+  const stream::ReadOptions read_options = cli::read_options_from(args);
+  const stream::WriteOptions write_options = cli::write_options_from(args, files);
   std::size_t next_file = 0;
   std::unique_ptr<stream::RecordReader> reader;
   // The inputs one after another, each opened when the one before has ended.

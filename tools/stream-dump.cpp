@@ -14,7 +14,7 @@
 #include "stream/npy.hpp"
 #include "stream/reader.hpp"
 #include "stream/record_types.hpp"
-#include "stream/stream_options.hpp"
+#include "cli/stream_options.hpp"
 
 using namespace qte;
 
@@ -56,7 +56,7 @@ static cli::Usage usage() {
       {"summary", "", "print only a count of records and bytes per type at the end", ""},
       {"text", "", "with --npy or --pcd, print the records as well (without it those write files only; --json "
                    "prints them as JSON Lines)", ""},
-      stream::max_record_bytes_option(),
+      cli::max_record_bytes_option(),
   };
   u.examples = {
       {"stream-dump demos.rec", "list every record of a file with its fields"},
@@ -96,7 +96,7 @@ static void run(const cli::Arguments& args) {
   OutputDirectory* pcd = pcd_out ? pcd_out.get() : args.has("pcd") ? npy_out.get() : nullptr;
   std::unique_ptr<stream::NpyExport> npy;
   if (npy_out) npy = std::make_unique<stream::NpyExport>(npy_out->staging(), args.flag("per-record"));
-  const stream::ReadOptions read_options = stream::read_options_from(args);
+  const stream::ReadOptions read_options = cli::read_options_from(args);
 
   // Exporting is what --npy and --pcd are for: the text too only when asked for.
   const bool print_records =

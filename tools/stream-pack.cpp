@@ -1,7 +1,7 @@
 // stream-pack: write one record from command-line values and .npy files.
 #include "cli/command.hpp"
 #include "stream/field_spec.hpp"
-#include "stream/stream_options.hpp"
+#include "cli/stream_options.hpp"
 #include "stream/writer.hpp"
 
 using namespace qte;
@@ -26,7 +26,7 @@ static cli::Usage usage() {
   u.options = {
       {"compress", "", "zstd-compress arrays of 256 bytes or more", ""},
   };
-  u.add_options(stream::append_options());
+  u.add_options(cli::append_options());
   u.options.push_back(cli::output_file());
   u.examples = {
       {"stream-pack reset task=reach_target variation:i32=0 seed:i64=7 > reset.rec",
@@ -51,7 +51,7 @@ static void run(const cli::Arguments& args) {
     }
     record = std::move(compressed);
   }
-  stream::RecordWriter writer(args.text("output"), stream::write_options_from(args, {}));
+  stream::RecordWriter writer(args.text("output"), cli::write_options_from(args, {}));
   writer.write(record);
   writer.close();
 }

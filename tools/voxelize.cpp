@@ -7,7 +7,7 @@
 #include "stream/stage.hpp"
 #include "stream/writer.hpp"
 #include "voxels/hierarchy_options.hpp"
-#include "voxels/voxels_record.hpp"
+#include "voxel_occupancy/voxels_record.hpp"
 
 using namespace qte;
 
@@ -65,7 +65,7 @@ static void run(const cli::Arguments& args) {
   std::unique_ptr<OutputDirectory> pictures;  // all or none
   if (args.has("png")) pictures = std::make_unique<OutputDirectory>(args.text("png"));
 
-  voxels::VoxelizeStage stage({scene, crops, args.flag("octomap-channels")}, pictures ? pictures->staging() : "",
+  voxel_occupancy::VoxelizeStage stage({scene, crops, args.flag("octomap-channels")}, pictures ? pictures->staging() : "",
                               point_clouds::observation_filter(point_clouds::parse_cloud_filters(args)));
   stream::RecordReader reader(args.input());
   stream::RecordWriter writer(args.text("output"));

@@ -1,6 +1,7 @@
 #include "camera_recordings/camera_options.hpp"
 
 #include "camera_recordings/recording.hpp"
+#include "cli/stream_options.hpp"
 #include "voxels/observation_cloud.hpp"
 
 namespace qte::camera_recordings {
@@ -12,7 +13,7 @@ std::vector<cli::OptionSpec> camera_setup_options() {
       {"camera-pose", "X,Y,Z,QX,QY,QZ,QW", "camera-to-world pose, metres and unit quaternion", ""},
       {"extrinsics", "M00,...,M33", "camera-to-world 4x4 matrix, 16 numbers row by row (instead of --camera-pose)", ""},
       {"depth-unit", "M", "metres per depth count", "0.001"},
-      voxels::no_points_option(),
+      cli::no_points_option(),
   };
 }
 

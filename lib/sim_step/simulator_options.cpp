@@ -7,7 +7,7 @@
 #include "stream/reader.hpp"
 #include "stream/writer.hpp"
 #include "tasks/task.hpp"
-#include "voxels/observation_cloud.hpp"
+#include "cli/stream_options.hpp"
 
 namespace qte::sim_step {
 
@@ -16,7 +16,7 @@ std::vector<cli::OptionSpec> camera_options() {
       {"cameras", "LIST", "comma-separated cameras: front, wrist, overhead", "front"},
       {"image-size", "WxH", "camera resolution, e.g. 128x128 or 256x256", "128x128"},
       {"compress", "", "zstd-compress images and point clouds (for files on disk)", ""},
-      voxels::no_points_option(),
+      cli::no_points_option(),
       {"objects", "", "also write every task object's name, role (target, distractor, other), pose, bounding box "
                       "and whether the gripper holds it in observations (objects.*: for analyses of where an agent "
                       "went and why it failed; agents never read them)", ""},

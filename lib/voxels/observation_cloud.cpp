@@ -159,11 +159,4 @@ std::vector<CameraCloud> camera_clouds(const stream::Record& obs) {
   return clouds;
 }
 
-cli::OptionSpec no_points_option() {
-  return {"no-points", "",
-          "leave the world-frame point clouds (<camera>.points) out of the observations written (readers rebuild them "
-          "from depth; smaller files)",
-          ""};
-}
-
 }  // namespace qte::voxels

@@ -8,7 +8,6 @@
 #include <string>
 #include <vector>
 
-#include "cli/command.hpp"
 #include "stream/record.hpp"
 #include "voxels/voxel_grid.hpp"
 
@@ -37,9 +36,6 @@ std::vector<CameraCloud> camera_clouds(const stream::Record& obs);
 // camera to world): finite, a proper rotation (orthonormal, determinant +1, within 1e-3),
 // last row 0 0 0 1. A camera failing these sees nothing, or a mirror image of the scene.
 std::string intrinsics_problem(const double* k);
-// --no-points: leave <camera>.points out of the observations a program writes (sim-step,
-// demo-record, obs-pack); every reader rebuilds them from depth, intrinsics and extrinsics.
-cli::OptionSpec no_points_option();
 std::string extrinsics_problem(const double* e);
 // The record's <camera>.intrinsics (when present) and <camera>.extrinsics, checked as above:
 // fails naming the record and the field. Every reader of camera matrices calls this.

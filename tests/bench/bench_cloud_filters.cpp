@@ -9,7 +9,7 @@
 
 #include "point_clouds/cloud_filters.hpp"
 #include "sim_step/simulator.hpp"
-#include "voxels/voxels_record.hpp"
+#include "voxel_occupancy/voxels_record.hpp"
 
 using namespace qte;
 using Clock = std::chrono::steady_clock;
@@ -35,8 +35,8 @@ int main() {
     stream::Record obs("obs");
     sim.handle(sim_step::plan_reset({"pick_and_lift", 0, 1, 2}, 0), [&](const stream::Record& r) { obs = r; });
     const std::size_t points = voxels::observation_cloud(obs).view().count;
-    voxels::VoxelsRecordOptions grid;
-    const double voxelize = median_ms([&] { (void)voxels::voxels_of(obs, grid); }, 30);
+    voxel_occupancy::VoxelsRecordOptions grid;
+    const double voxelize = median_ms([&] { (void)voxel_occupancy::voxels_of(obs, grid); }, 30);
     std::printf("%dx%d front camera, %zu pixels: voxelize (16^3, no filter) %.2f ms\n", side, side, points, voxelize);
     point_clouds::CloudFilters crop, outliers, downsample, all;
     crop.crop = all.crop = Eigen::AlignedBox3f(Eigen::Vector3f(-0.3f, -0.5f, 0.6f), Eigen::Vector3f(0.7f, 0.5f, 1.6f));

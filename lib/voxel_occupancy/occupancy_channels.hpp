@@ -9,7 +9,7 @@
 #include "stream/record.hpp"
 #include "voxels/voxel_grid.hpp"
 
-namespace qte::voxels {
+namespace qte::voxel_occupancy {
 
 constexpr int kOccupancyChannels = 2;  // free, unknown (occupied is channel 9 already)
 
@@ -19,7 +19,7 @@ class ObservedSpace {
   explicit ObservedSpace(const stream::Record& obs, double resolution_m = 0.01);
   ~ObservedSpace();
   // voxels^3 * kOccupancyChannels floats for `bounds`, index order x, y, z.
-  void channels(const GridBounds& bounds, float* out) const;
+  void channels(const voxels::GridBounds& bounds, float* out) const;
 
  private:
   struct Impl;
@@ -29,4 +29,4 @@ class ObservedSpace {
 // Interleaves `extra` channels after the kChannels of `grid`: out has kChannels + extra_count.
 std::vector<float> append_channels(const float* grid, const float* extra, int voxels, int extra_count);
 
-}  // namespace qte::voxels
+}  // namespace qte::voxel_occupancy

@@ -1,4 +1,4 @@
-#include "voxels/voxels_record.hpp"
+#include "voxel_occupancy/voxels_record.hpp"
 
 #include <cstdio>
 #include <memory>
@@ -6,10 +6,12 @@
 #include "voxels/grid_fields.hpp"
 #include "common/indexed_name.hpp"
 #include "voxels/observation_cloud.hpp"
-#include "voxels/occupancy_channels.hpp"
+#include "voxel_occupancy/occupancy_channels.hpp"
 #include "voxels/voxel_image.hpp"
 
-namespace qte::voxels {
+namespace qte::voxel_occupancy {
+
+using namespace voxels;  // the grids these channels and records are made of
 
 VoxelsOfObservation voxels_of(const stream::Record& obs, const VoxelsRecordOptions& options) {
   const int64_t v = options.scene.voxels, k = static_cast<int64_t>(options.crops.size());
@@ -64,4 +66,4 @@ void VoxelizeStage::save_pictures(uint64_t record_index, const std::vector<float
                    grids.data() + (1 + c) * grid_floats, v);
 }
 
-}  // namespace qte::voxels
+}  // namespace qte::voxel_occupancy

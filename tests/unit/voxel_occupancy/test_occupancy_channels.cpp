@@ -1,7 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "sim_step/simulator.hpp"
-#include "voxels/occupancy_channels.hpp"
+#include "voxel_occupancy/occupancy_channels.hpp"
 
 using namespace qte;
 
@@ -12,13 +12,13 @@ TEST(OccupancyChannels, FreeInViewUnknownUnderTheTable) {
   sim_step::Simulator sim(robot, options);
   stream::Record obs("obs");
   sim.handle(sim_step::plan_reset({"reach_target", 0, 1, 2}, 0), [&](const stream::Record& r) { obs = r; });
-  const voxels::ObservedSpace space(obs);
+  const voxel_occupancy::ObservedSpace space(obs);
   voxels::GridBounds bounds;  // the scene cube, 16^3
-  std::vector<float> channels(16 * 16 * 16 * voxels::kOccupancyChannels);
+  std::vector<float> channels(16 * 16 * 16 * voxel_occupancy::kOccupancyChannels);
   space.channels(bounds, channels.data());
   auto at = [&](const Eigen::Vector3d& p, int channel) {
     const Eigen::Vector3i i = bounds.index_of(p);
-    return channels[((i.x() * 16 + i.y()) * 16 + i.z()) * voxels::kOccupancyChannels + channel];
+    return channels[((i.x() * 16 + i.y()) * 16 + i.z()) * voxel_occupancy::kOccupancyChannels + channel];
   };
   const double table = sim.world()->layout().table_height_m;
   EXPECT_EQ(at({0.3, 0.0, table + 0.45}, 0), 1.0f);   // in front of the camera, above the table: free

@@ -9,8 +9,8 @@
 #include "sim_step/simulator.hpp"
 #include "voxels/grid_fields.hpp"
 #include "voxels/observation_cloud.hpp"
-#include "voxels/occupancy_channels.hpp"
-#include "voxels/voxels_record.hpp"
+#include "voxel_occupancy/occupancy_channels.hpp"
+#include "voxel_occupancy/voxels_record.hpp"
 
 using namespace qte;
 
@@ -35,9 +35,9 @@ std::vector<float> field_floats(const stream::Record& r, const std::string& name
 
 TEST(VoxelsRecord, GridsAreTheVoxelizersAndCropsFollowTheScene) {
   const stream::Record obs = first_observation();
-  voxels::VoxelsRecordOptions options;
+  voxel_occupancy::VoxelsRecordOptions options;
   options.crops = {voxels::GridBounds::around({0.2, 0.0, 0.8}, 0.15, 16), voxels::GridBounds::around({0.1, 0.2, 0.9}, 0.15, 16)};
-  const voxels::VoxelsOfObservation out = voxels::voxels_of(obs, options);
+  const voxel_occupancy::VoxelsOfObservation out = voxel_occupancy::voxels_of(obs, options);
 
   const voxels::ObservationCloud cloud = voxels::observation_cloud(obs);
   const std::size_t floats = 16 * 16 * 16 * voxels::kChannels;
@@ -62,13 +62,13 @@ TEST(VoxelsRecord, GridsAreTheVoxelizersAndCropsFollowTheScene) {
 
 TEST(VoxelsRecord, OccupancyChannelsFollowTheTenAndNoCropsMeansNoDepth1) {
   const stream::Record obs = first_observation();
-  voxels::VoxelsRecordOptions options;
+  voxel_occupancy::VoxelsRecordOptions options;
   options.scene.voxels = 8;
-  const voxels::VoxelsOfObservation plain = voxels::voxels_of(obs, options);
+  const voxel_occupancy::VoxelsOfObservation plain = voxel_occupancy::voxels_of(obs, options);
   options.occupancy_channels = true;
-  const voxels::VoxelsOfObservation out = voxels::voxels_of(obs, options);
+  const voxel_occupancy::VoxelsOfObservation out = voxel_occupancy::voxels_of(obs, options);
   EXPECT_FALSE(out.record.has("depth1.grid"));
-  const int c = voxels::kChannels + voxels::kOccupancyChannels;
+  const int c = voxels::kChannels + voxel_occupancy::kOccupancyChannels;
   EXPECT_EQ(out.record.field("depth0.grid").shape(), (stream::Shape{8, 8, 8, c}));
   const auto with = out.record.array<float>("depth0.grid"), without = plain.record.array<float>("depth0.grid");
   for (int cell = 0; cell < 8 * 8 * 8; ++cell)
@@ -80,7 +80,7 @@ TEST(VoxelsRecord, OccupancyChannelsFollowTheTenAndNoCropsMeansNoDepth1) {
 TEST(VoxelizeStage, PassesRecordsThroughAndFollowsEachObservationWithItsVoxels) {
   stream::Record obs = first_observation();
   obs.position.record_index = 4;
-  voxels::VoxelsRecordOptions options;
+  voxel_occupancy::VoxelsRecordOptions options;
   options.crops = {voxels::GridBounds::around({0.2, 0.0, 0.8}, 0.15, 16)};
   const std::string pictures = ::testing::TempDir();
   // Every point dropped (NaN: no return): the stage must voxelize this, not the record it passes on.
@@ -91,7 +91,7 @@ TEST(VoxelizeStage, PassesRecordsThroughAndFollowsEachObservationWithItsVoxels) 
     return emptied;
   };
   int prepared = 0;
-  voxels::VoxelizeStage stage(options, pictures, [&](const stream::Record& r) {
+  voxel_occupancy::VoxelizeStage stage(options, pictures, [&](const stream::Record& r) {
     ++prepared;
     return without_points(r);
   });
@@ -106,8 +106,8 @@ TEST(VoxelizeStage, PassesRecordsThroughAndFollowsEachObservationWithItsVoxels) 
   EXPECT_EQ(out[2].type(), "voxels");
   EXPECT_EQ(prepared, 1);
   EXPECT_EQ(field_floats(out[2], "depth0.grid"),
-            field_floats(voxels::voxels_of(without_points(obs), options).record, "depth0.grid"));
-  EXPECT_NE(field_floats(out[2], "depth0.grid"), field_floats(voxels::voxels_of(obs, options).record, "depth0.grid"));
+            field_floats(voxel_occupancy::voxels_of(without_points(obs), options).record, "depth0.grid"));
+  EXPECT_NE(field_floats(out[2], "depth0.grid"), field_floats(voxel_occupancy::voxels_of(obs, options).record, "depth0.grid"));
   for (const char* name : {"000004.depth0.png", "000004.depth1.0.png"}) {
     const std::string path = pictures + "/" + name;
     EXPECT_EQ(::access(path.c_str(), R_OK), 0) << path;

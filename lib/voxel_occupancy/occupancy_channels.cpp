@@ -1,9 +1,11 @@
-#include "voxels/occupancy_channels.hpp"
+#include "voxel_occupancy/occupancy_channels.hpp"
 
 #include "planning/occupancy_scene.hpp"
 #include "voxels/observation_cloud.hpp"
 
-namespace qte::voxels {
+namespace qte::voxel_occupancy {
+
+using namespace voxels;  // the grids these channels and records are made of
 
 struct ObservedSpace::Impl {
   planning::OccupancyScene scene;
@@ -50,4 +52,4 @@ std::vector<float> append_channels(const float* grid, const float* extra, int vo
   return out;
 }
 
-}  // namespace qte::voxels
+}  // namespace qte::voxel_occupancy

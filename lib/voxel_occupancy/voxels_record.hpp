@@ -13,11 +13,11 @@
 #include "stream/stage.hpp"
 #include "voxels/voxel_grid.hpp"
 
-namespace qte::voxels {
+namespace qte::voxel_occupancy {
 
 struct VoxelsRecordOptions {
-  GridBounds scene;
-  std::vector<GridBounds> crops;  // the deeper grids, each of scene.voxels per side
+  voxels::GridBounds scene;
+  std::vector<voxels::GridBounds> crops;  // the deeper grids, each of scene.voxels per side
   bool occupancy_channels = false;
 };
 
@@ -47,4 +47,4 @@ class VoxelizeStage : public stream::Stage {
   std::function<stream::Record(const stream::Record&)> prepare_;
 };
 
-}  // namespace qte::voxels
+}  // namespace qte::voxel_occupancy
