@@ -58,15 +58,13 @@
 set -euo pipefail
 task=$1 run=$2
 source "$(dirname "$0")/common.sh"
-read -r method_act_k method_target_k <<< "$(method_k "${METHOD:-qte}" 10)"  # METHOD's K by default
-: "${SEED:=0}" "${DEMOS:=10}" "${VARIATION:=0}" "${IMAGE:=128x128}" "${ACT_K:=$method_act_k}" "${TARGET_K:=$method_target_k}"
-: "${ENV_STEPS:=2000}" "${CHUNK_EPISODES:=10}" "${EVAL_EVERY:=250}" "${EVAL_EPISODES:=50}" "${EVAL_SEED:=1000000}"
-: "${ARCH:=light}" "${BATCH:=32}" "${RATIO:=0.5}" "${PRETRAIN:=200}" "${START_AFTER:=0}"
-: "${LEARNER_THREADS:=1}" "${EPSILON:=0.1}" "${ROTATION_NOISE:=1}" "${CHECKPOINT_EVERY:=25}"
-: "${N_STEP:=1}" "${ACTORS:=1}" "${CPU_BUDGET:=0}" "${K_MARGIN:=0.02}" "${K_MAX:=10}" "${ROLE:=all}" "${ACTOR_INDEX:=0}"
-: "${ALSO_ACT_K:=}" "${METHOD:=qte}" "${LABEL:=$(run_label "$METHOD" "$ACT_K" "$TARGET_K" "$K_MARGIN" "$K_MAX")}"
-: "${STAGE:=sim-step --image-size $IMAGE}" "${DEMOS_FROM:=}" "${TIME_BUDGET:=0}" "${NET_OPTIONS:=}"
-: "${PLAN_OPTIONS:=}" "${EVAL_STAGE:=$STAGE}" "${ACCOUNT_EVERY:=30}" "${PRECISION:=auto}" "${STALL_SECONDS:=1800}"
+source "$(dirname "$0")/settings.sh"
+settings_load learn.sh  # settings.txt: defaults, checks, misspellings refused
+# The task, known to the simulator (a real robot's runs name theirs freely).
+if [[ $STAGE == sim-step* ]] && ! sim-step --list-tasks | cut -f1 | grep -x -- "$task" > /dev/null; then
+  echo "learn.sh: $task is not a task (sim-step --list-tasks: $(sim-step --list-tasks | cut -f1 | xargs | tr ' ' ,))" >&2
+  exit 2
+fi
 export PLAN_OPTIONS  # failure_reasons.sh plans the final agent's moves the same way
 eval "stage=($STAGE)"
 eval "eval_stage=($EVAL_STAGE)"

@@ -1,4 +1,6 @@
 // sim-step: the simulator as a filter: reset and trajectory records in, observations out.
+#include <iostream>
+
 #include "cli/command.hpp"
 #include "robot/robot_model.hpp"
 #include "sim_step/simulator.hpp"
@@ -40,6 +42,8 @@ static cli::Usage usage() {
       {"every-step", "", "also write an observation at every 50 ms control step of a trajectory "
                          "(full demonstrations)", ""},
       {"threads", "N", "rendering threads", "2"},
+      {"list-tasks", "", "print the tasks, one a line: name, variations, episode length and what variation 0 asks "
+                         "(tab-separated), and exit", ""},
   };
   u.options.push_back(cli::output_file());
   u.add_options(sim_step::chunk_options());
@@ -62,6 +66,14 @@ static cli::Usage usage() {
 }
 
 static void run(const cli::Arguments& args) {
+  if (args.flag("list-tasks")) {
+    for (const std::string& name : tasks::task_names()) {
+      const auto task = tasks::make_task(name);
+      std::cout << name << '\t' << task->variation_count() << '\t' << task->episode_length() << '\t'
+                << task->description(0) << '\n';
+    }
+    return;
+  }
   sim_step::SimulatorOptions options = sim_step::parse_camera_options(args);
   options.observe_every_step = args.flag("every-step");
   options.render_threads = static_cast<int>(args.integer("threads", 1, 256));
