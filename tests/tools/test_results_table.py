@@ -232,6 +232,18 @@ def main():
         assert pooled[2]["mean_difference"] == f"{mean:+.3f}", pooled[2]
         assert pooled[2]["sign_flip_p"] == f"{brute:.4f}", (pooled[2], brute)
         assert pooled[2]["mean_success"] == f"{statistics.mean(q for _, q in reach + lid) / 50:.3f}"
+        # The pooled row's flips are per pair, counted by hand: task A's pairs +0.2 and +0.1, task B's
+        # -0.1; of the 8 sign assignments 6 reach |sum| >= 0.2 (p = 0.75). Flipping each task's pairs
+        # together (4 assignments of +0.3 and -0.1) would give 1.0.
+        by_hand = os.path.join(d, "by_hand")
+        os.makedirs(by_hand)
+        files = []
+        for task, task_pairs in [("task_a", [(10, 20), (10, 15)]), ("task_b", [(20, 15)])]:
+            for seed, (base, qte) in enumerate(task_pairs):
+                files.append(write_run(by_hand, f"{task}_c2farm-k1-t0-seed{seed}.csv", "c2farm-k1-t0", seed, [(base, 9)]))
+                files.append(write_run(by_hand, f"{task}_qte-k10-t10-seed{seed}.csv", "qte-k10-t10", seed, [(qte, 9)]))
+        hand = rows_of(run("--paired", "c2farm-k1-t0", *files).stdout)
+        assert [(r["task"], r["pairs"], r["sign_flip_p"]) for r in hand][-1] == ("all 2 tasks", "3", "0.7500"), hand
         # Rates over 3 episodes (thirds) are counted on their common denominator, differences that
         # are no such fractions enumerated: both as the brute force here; too many of the latter
         # to enumerate are refused.
