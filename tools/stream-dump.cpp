@@ -43,6 +43,13 @@ static cli::Usage usage() {
       "pixel has no return), for pcl_viewer and other PCL programs.",
       "The exported files appear all or none: a dump stopped by damage leaves the directories "
       "as they were.",
+      "With --schema no stream is read: the registry of record types and their fields "
+      "(formats/record-stream.md, section 12) is printed instead, per type a line TYPE, what it "
+      "holds and the programs that write it, then one line per field: a tab, then name, dtype, "
+      "shape, 'optional' or 'required', and meaning, tab-separated. Names written <camera>.rgb "
+      "stand for one field per camera (front.rgb, ...), depth<d>.index for one per depth "
+      "(depth0.index, ...); shapes name sizes by letters ([H, W, 3]) and scalars as []. With "
+      "--type only those types are printed.",
   };
   u.arguments = {cli::input_files()};
   u.options = {
@@ -54,6 +61,8 @@ static cli::Usage usage() {
       {"per-record", "", "with --npy, write one .npy file per record and field instead of stacked arrays", ""},
       {"pcd", "DIR", "also export every camera's point cloud of the shown observations as .pcd files into DIR", ""},
       {"summary", "", "print only a count of records and bytes per type at the end", ""},
+      {"schema", "", "print the record types and their fields (name, dtype, shape, optional, meaning) "
+                     "instead of reading streams", ""},
       {"text", "", "with --npy or --pcd, print the records as well (without it those write files only; --json "
                    "prints them as JSON Lines)", ""},
       cli::max_record_bytes_option(),
@@ -66,6 +75,7 @@ static cli::Usage usage() {
        "the observations as stacked NumPy arrays (arrays/obs.front.rgb.npy, ...)"},
       {"stream-dump --pcd clouds/ episode.rec && pcl_viewer clouds/000000.front.pcd",
        "look at the first observation's point cloud in PCL's viewer"},
+      {"stream-dump --schema --type obs", "the fields an observation holds, with dtype, shape and meaning"},
   };
   u.see_also = {"qte-stream(5)", "stream-cat(1)", "stream-pack(1)"};
   return u;
@@ -84,6 +94,15 @@ static void run(const cli::Arguments& args) {
   for (const std::string& type : types)
     if (!stream::find_record_type(type))
       throw UsageError("--type " + type + ": no such record type (the types: " + stream::record_type_names() + ")");
+  if (args.flag("schema")) {
+    if (!args.positional().empty()) throw UsageError("--schema reads no stream (given: " + args.positional()[0] + ")");
+    for (const char* other : {"json", "values", "all-values", "npy", "per-record", "pcd", "summary", "text"})
+      if (args.has(other)) throw UsageError(std::string("--schema takes no --") + other + " (only --type)");
+    for (const stream::RecordType& type : stream::record_types())
+      if (types.empty() || types.count(type.name)) std::cout << stream::schema_text(type);
+    flush_or_stop();
+    return;
+  }
   stream::InspectOptions inspect;
   inspect.max_values = args.flag("all-values") ? -1 : args.integer("values", -1, 1000000000);
   if (args.flag("per-record") && !args.has("npy")) throw UsageError("--per-record goes with --npy DIR");
