@@ -6,8 +6,10 @@ set -euo pipefail
 dir=$(dirname "$0")/images
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-task_set_1="take_lid_off_saucepan pick_up_cup put_rubbish_in_bin stack_wine phone_on_base take_umbrella_out_of_umbrella_stand"
-for task in reach_target pick_and_lift lift_numbered_block reach_prism pick_and_lift_small stack_blocks setup_checkers $task_set_1; do
+# The tasks and their sets from tasks.txt (the Makefile's table); Task Set 1 but for the first two.
+tasks=$(sed -n 's/^\([a-z_]\{1,\}\) *|.*/\1/p' "$(dirname "$0")/tasks.txt")
+task_set_1=$(sed -n 's/^\([a-z_]\{1,\}\) *| *1 *|.*/\1/p' "$(dirname "$0")/tasks.txt" | grep -vx 'reach_target\|pick_and_lift')
+for task in $tasks; do
   sim-step --task "$task" --seed 1 --image-size 256x256 --cameras front,overhead < /dev/null \
     | stream-png --dir "$tmp/$task"
   cp "$tmp/$task/000000.front.rgb.png" "$dir/$task.png"

@@ -11,20 +11,6 @@
 
 namespace qte::tasks {
 
-std::unique_ptr<Task> make_reach_target();
-std::unique_ptr<Task> make_pick_and_lift();
-std::unique_ptr<Task> make_lift_numbered_block();
-std::unique_ptr<Task> make_reach_prism();
-std::unique_ptr<Task> make_pick_and_lift_small();
-std::unique_ptr<Task> make_stack_blocks();
-std::unique_ptr<Task> make_setup_checkers();
-std::unique_ptr<Task> make_take_lid_off_saucepan();
-std::unique_ptr<Task> make_pick_up_cup();
-std::unique_ptr<Task> make_put_rubbish_in_bin();
-std::unique_ptr<Task> make_stack_wine();
-std::unique_ptr<Task> make_phone_on_base();
-std::unique_ptr<Task> make_take_umbrella_out_of_umbrella_stand();
-
 struct NamedColour {
   std::string name;
   Eigen::Vector3f rgb;

@@ -8,25 +8,31 @@
 
 namespace qte::tasks {
 
+// Every task, in the order usage texts list them: the one place a task is registered, a line
+// each (tasks/<name>.cpp defines make_<name>()).
+#define QTE_EVERY_TASK(TASK)              \
+  TASK(reach_target)                      \
+  TASK(pick_and_lift)                     \
+  TASK(lift_numbered_block)               \
+  TASK(reach_prism)                       \
+  TASK(pick_and_lift_small)               \
+  TASK(stack_blocks)                      \
+  TASK(setup_checkers)                    \
+  TASK(take_lid_off_saucepan)             \
+  TASK(pick_up_cup)                       \
+  TASK(put_rubbish_in_bin)                \
+  TASK(stack_wine)                        \
+  TASK(phone_on_base)                     \
+  TASK(take_umbrella_out_of_umbrella_stand)
+
+#define QTE_DECLARE_TASK(name) std::unique_ptr<Task> make_##name();
+QTE_EVERY_TASK(QTE_DECLARE_TASK)
+
 namespace {
 
-// Every task by name, in the order usage texts list them: the one place a task is registered.
 const std::vector<std::pair<std::string, std::unique_ptr<Task> (*)()>>& registry() {
-  static const std::vector<std::pair<std::string, std::unique_ptr<Task> (*)()>> tasks = {
-      {"reach_target", make_reach_target},
-      {"pick_and_lift", make_pick_and_lift},
-      {"lift_numbered_block", make_lift_numbered_block},
-      {"reach_prism", make_reach_prism},
-      {"pick_and_lift_small", make_pick_and_lift_small},
-      {"stack_blocks", make_stack_blocks},
-      {"setup_checkers", make_setup_checkers},
-      {"take_lid_off_saucepan", make_take_lid_off_saucepan},
-      {"pick_up_cup", make_pick_up_cup},
-      {"put_rubbish_in_bin", make_put_rubbish_in_bin},
-      {"stack_wine", make_stack_wine},
-      {"phone_on_base", make_phone_on_base},
-      {"take_umbrella_out_of_umbrella_stand", make_take_umbrella_out_of_umbrella_stand},
-  };
+#define QTE_REGISTER_TASK(name) {#name, make_##name},
+  static const std::vector<std::pair<std::string, std::unique_ptr<Task> (*)()>> tasks = {QTE_EVERY_TASK(QTE_REGISTER_TASK)};
   return tasks;
 }
 

@@ -46,4 +46,19 @@ for name in EVAL_EPISODE TAKEAWAY2_SEED; do
 done
 make -C "$src/examples" -n reach_target SEED=3 "TAKEAWAY2_SEEDS=7 8" RUNS="$tmp/runs" > /dev/null 2> "$tmp/make.err" \
   || fail "make with known names refused: $(cat "$tmp/make.err")"
+# The task table (examples/tasks.txt): a row for every task the simulator has, in its order,
+# each budget made of settings that pass their checks; the Makefile's lists come from it.
+table_tasks=$(sed -n 's/^\([a-z_]\{1,\}\) *|.*/\1/p' "$src/examples/tasks.txt" | xargs)
+[ "$table_tasks" = "$(sim-step --list-tasks | cut -f1 | xargs)" ] \
+  || fail "examples/tasks.txt's tasks ($table_tasks) are not sim-step --list-tasks' ($(sim-step --list-tasks | cut -f1 | xargs))"
+sed -n 's/^[a-z_]\{1,\} *| *[a-z0-9]\{1,\} *| *[a-z]\{1,\} *| *//p' "$src/examples/tasks.txt" | tr ' ' '\n' | sort -u > "$tmp/budget"
+while IFS='=' read -r name value; do
+  row=$(grep "^$name " "$src/examples/settings.txt") || fail "tasks.txt: $name is not a setting"
+  check=$(cut -d'|' -f3 <<< "$row" | sed 's/^ //; s/ $//')
+  problem=$(bash -c ". '$src/examples/settings.sh'; setting_problem \"\$1\" \"\$2\"" x "$value" "$check")
+  [ -z "$problem" ] || fail "tasks.txt: $name=$value: $problem"
+done < "$tmp/budget"
+listed=$(make -s -C "$src/examples" --eval 'print-task-lists: ; @echo $(TASK_SET_1) / $(APPROACH_TASKS)' print-task-lists)
+[ "$listed" = "take_lid_off_saucepan pick_up_cup put_rubbish_in_bin stack_wine phone_on_base take_umbrella_out_of_umbrella_stand / stack_blocks setup_checkers pick_up_cup put_rubbish_in_bin stack_wine phone_on_base take_umbrella_out_of_umbrella_stand" ] \
+  || fail "the Makefile's task lists from tasks.txt: $listed"
 echo "ok: settings declared once, misspellings, ranges and tasks refused before a run starts"
