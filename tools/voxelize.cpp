@@ -21,7 +21,9 @@ static cli::Usage usage() {
       "a deeper grid of centre +- --offset (the crops coarse-to-fine attention zooms into). The "
       "point cloud is every camera's <camera>.points with <camera>.rgb (or points rebuilt from "
       "<camera>.depth / depth_mm and the camera's intrinsics and extrinsics); points outside a "
-      "grid, and pixels without a return, are ignored.",
+      "grid, and pixels without a return, are ignored. An observation with no point inside the scene "
+      "bounds is refused (exit 1, naming the record), as qte-select and qattn-train refuse it: its "
+      "grid would be empty.",
       "Each voxel has 10 channels, channels last: the mean x, y, z of its points (world frame, "
       "metres), their mean r, g, b scaled to [-1, 1], the voxel's index divided by the grid "
       "size for x, y, z, and occupancy (1 when it holds a point); empty voxels are zero but "

@@ -17,6 +17,7 @@ VoxelsOfObservation voxels_of(const stream::Record& obs, const VoxelsRecordOptio
   const int64_t v = options.scene.voxels, k = static_cast<int64_t>(options.crops.size());
   const std::size_t grid_floats = static_cast<std::size_t>(v * v * v) * kChannels;
   const ObservationCloud cloud = observation_cloud(obs);
+  require_points_in_scene(obs, cloud, options.scene);  // an empty grid is refused, as qte-select does
   VoxelsOfObservation out;
   out.grids.resize(grid_floats * (1 + options.crops.size()));
   voxelize(cloud.view(), options.scene, out.grids.data());

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Nothing seen, nothing done: qte-select and qattn-train refuse an observation with no point
+# Nothing seen, nothing done: voxelize, qte-select and qattn-train refuse an observation with no point
 # inside the scene bounds (here a camera facing away, placed far off), naming the record and
 # saying what to check; bad camera matrices are refused where they are read.
 source "$(dirname "$0")/common.sh"
@@ -36,6 +36,10 @@ obs 0 0 "$away" > "$tmp/away.rec"
 expect "away.rec: record 0 at byte 0: 'obs' record: none of its 16 points lies inside the scene bounds.*check the cameras' extrinsics" \
   qte-select --checkpoint "$ckpt" "$tmp/away.rec"
 [ "$(stream-dump --type action --summary "$tmp/out" | cut -f2)" != "1 records" ] || fail "qte-select chose an action on an empty scene"
+# voxelize refuses it too, rather than write an empty grid the networks would then refuse.
+expect "away.rec: record 0 at byte 0: 'obs' record: none of its 16 points lies inside the scene bounds" \
+  voxelize --output "$tmp/away_voxels.rec" "$tmp/away.rec"
+[ ! -e "$tmp/away_voxels.rec" ] || fail "voxelize left its output for an empty scene"
 obs 0 0 "$mirror" > "$tmp/mirror.rec"
 expect "'front.extrinsics': expected a camera-to-world pose: a proper rotation" qte-select --checkpoint "$ckpt" "$tmp/mirror.rec"
 obs 0 0 "$seen" 0,0,2,0,0,2,0,0,1 > "$tmp/zero_focal.rec"
