@@ -16,7 +16,16 @@
 
 using namespace qte;
 
+// The options' defaults are RobotOptions' own (lib/robot_step/robot_world.hpp).
+static std::string workspace_text(const Eigen::AlignedBox3d& box) {
+  std::string text;
+  for (const Eigen::Vector3d& corner : {box.min(), box.max()})
+    for (int k = 0; k < 3; ++k) text += (text.empty() ? "" : ",") + cli::default_text(corner[k]);
+  return text;
+}
+
 static cli::Usage usage() {
+  const robot_step::RobotOptions defaults;
   cli::Usage u;
   u.name = "robot-step";
   u.summary = "run a real robot and camera as sim-step runs the simulator: trajectories in, observations out";
@@ -73,12 +82,14 @@ static cli::Usage usage() {
                             "0,-20.05,0,42.97,0,63.03,0: the gripper above the table, pointing down)", ""},
       {"workspace", "X0,Y0,Z0,X1,Y1,Z1",
        "box the whole arm must stay in (world frame, m, within 10 m of the origin; the base excepted)",
-       "-0.65,-0.5,0.752,0.7,0.5,1.6"},
+       workspace_text(defaults.workspace)},
       {"reach-tolerance", "DEG", "largest difference between a motion's last row and the joints the driver reports",
-       "2"},
-      {"speed", "F", "fraction of each joint's speed limit a motion may use (faster ones are slowed)", "1"},
-      {"rate", "HZ", "rows per second of the motions handed to the arm (its servo rate)", "100"},
-      {"settle", "S", "seconds after a motion's end before its gripper command", "0.5"},
+       cli::default_text(defaults.reach_tolerance_deg)},
+      {"speed", "F", "fraction of each joint's speed limit a motion may use (faster ones are slowed)",
+       cli::default_text(defaults.speed_fraction)},
+      {"rate", "HZ", "rows per second of the motions handed to the arm (its servo rate)",
+       cli::default_text(defaults.rate_hz)},
+      {"settle", "S", "seconds after a motion's end before its gripper command", cli::default_text(defaults.settle_s)},
       {"episode-length", "N", "steps per episode (default: the task's, 10 without --task)", ""},
       {"stop-file", "FILE", "stop the robot at once when FILE exists", ""},
       {"motion-timeout", "S", "longest wait for the arm driver's answer", "120"},
