@@ -83,12 +83,15 @@ TEST(VoxelizeStage, PassesRecordsThroughAndFollowsEachObservationWithItsVoxels) 
   voxel_occupancy::VoxelsRecordOptions options;
   options.crops = {voxels::GridBounds::around({0.2, 0.0, 0.8}, 0.15, 16)};
   const std::string pictures = ::testing::TempDir();
-  // Every point dropped (NaN: no return): the stage must voxelize this, not the record it passes on.
+  // Every other pixel's point dropped (NaN: no return): the stage must voxelize this, not the
+  // record it passes on. (Dropping all of them would be an empty scene, which is refused.)
   const auto without_points = [](const stream::Record& r) {
-    stream::Record emptied = r;
+    stream::Record thinned = r;
     const auto points = r.array<float>("front.points");
-    emptied.set<float>("front.points", points.shape, std::vector<float>(points.size(), NAN));
-    return emptied;
+    std::vector<float> kept(points.data, points.data + points.size());
+    for (std::size_t i = 0; i < kept.size(); i += 6) kept[i] = kept[i + 1] = kept[i + 2] = NAN;
+    thinned.set<float>("front.points", points.shape, kept);
+    return thinned;
   };
   int prepared = 0;
   voxel_occupancy::VoxelizeStage stage(options, pictures, [&](const stream::Record& r) {
