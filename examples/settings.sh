@@ -51,11 +51,17 @@ nearest_names() {  # KNOWN_FILE NAME...
     }' "$known"
 }
 
+# A temporary file of every name a setting may have: settings.txt's and the Makefile's.
+known_names_file() {
+  local file; file=$(mktemp)
+  { settings_rows | cut -d'|' -f1; make_variable_names; } > "$file"
+  echo "$file"
+}
+
 # Names given on make's command line that are neither settings nor the Makefile's variables:
 # one line naming the first and the nearest known name, or nothing.
 settings_unknown_make_names() {  # NAME...
-  local known; known=$(mktemp)
-  { settings_rows | cut -d'|' -f1; make_variable_names; } > "$known"
+  local known; known=$(known_names_file)
   local name nearest
   read -r name nearest < <(nearest_names "$known" "$@") || true
   rm -f "$known"
@@ -107,8 +113,7 @@ settings_load() {  # PROGRAM
       exit 2
     fi
   done <<< "$rows"
-  local known; known=$(mktemp)
-  { cut -d'|' -f1 <<< "$rows"; make_variable_names; } > "$known"
+  local known; known=$(known_names_file)
   local nearest
   # Only names that look like settings: upper case, and near one (others are the system's).
   read -r name nearest < <(nearest_names "$known" $(compgen -e | grep -E '^[A-Z][A-Z0-9_]*$') | awk '$2 != "-"') || true

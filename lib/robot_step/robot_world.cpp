@@ -5,6 +5,7 @@
 #include <ostream>
 
 #include "camera_recordings/png_frames.hpp"
+#include "cli/command.hpp"
 #include "common/error.hpp"
 #include "planning/collision_checker.hpp"
 #include "robot/joint_path.hpp"
@@ -119,20 +120,14 @@ std::string RobotWorld::send(const std::vector<robot::XarmRow>& rows, const std:
         spool_.stop("robot-step stopped: " + why);
         throw Error(why + " (stop written)");
       }
-    joints_known_ = true;
-    const double off = (reached - last.degrees).cwiseAbs().maxCoeff();
-    if (off > options_.reach_tolerance_deg) {
-      joints_ = reached * (M_PI / 180.0);  // the arm is where the driver says, not where it was sent
-      gripper_m_ = gripper / robot::kXarmGripperOpenUnits * robot_.max_finger_opening_m();
-      char tolerance[32];
-      std::snprintf(tolerance, sizeof tolerance, "%g", options_.reach_tolerance_deg);
-      return "reached " + degrees_text(reached) + " deg, not the commanded " + degrees_text(last.degrees) +
-             " deg (more than " + tolerance + " deg away)";
-    }
   }
+  // The arm is where the driver says, whether or not that is where it was sent.
   joints_ = reached * (M_PI / 180.0);
   joints_known_ = true;
   gripper_m_ = gripper / robot::kXarmGripperOpenUnits * robot_.max_finger_opening_m();
+  if ((reached - last.degrees).cwiseAbs().maxCoeff() > options_.reach_tolerance_deg)
+    return "reached " + degrees_text(reached) + " deg, not the commanded " + degrees_text(last.degrees) +
+           " deg (more than " + cli::default_text(options_.reach_tolerance_deg) + " deg away)";
   return "";
 }
 
