@@ -12,12 +12,12 @@ run=$tmp/run
 export SEED=0 DEMOS=2 IMAGE=48x48 ACT_K=1 TARGET_K=0 ENV_STEPS=1000000 CHUNK_EPISODES=2 EVAL_EVERY=1000000 \
   EVAL_EPISODES=1 BATCH=4 PRETRAIN=2 RATIO=3 CHECKPOINT_EVERY=1 START_AFTER=0 CPU_BUDGET=1000000 ACCOUNT_EVERY=1
 
-# 0. learn.sh's pacing counts the steps allowed as qattn-train does.
-eval "$(sed -n '/^steps_allowed() {/p' "$learn")"
+# 0. The supervision's pacing counts the steps allowed as qattn-train does.
 for case in "0 200 0.5" "7 200 0.5" "3343 200 0.1" "1001 0 0.3" "45 2 3" "999999 100 0.7"; do
-  read -r n PRETRAIN RATIO <<<"$case"
-  [ "$(steps_allowed "$n")" = "$(qattn-train --steps-allowed "$n" --pretrain "$PRETRAIN" --replay-ratio "$RATIO")" ] \
-    || fail "steps allowed after $n transitions (pretrain $PRETRAIN, ratio $RATIO): learn.sh $(steps_allowed "$n")"
+  read -r n pretrain ratio <<<"$case"
+  ours=$("$py" "$QTE_SOURCE/examples/supervise.py" --steps-allowed "$n" --pretrain "$pretrain" --ratio "$ratio")
+  [ "$ours" = "$(qattn-train --steps-allowed "$n" --pretrain "$pretrain" --replay-ratio "$ratio")" ] \
+    || fail "steps allowed after $n transitions (pretrain $pretrain, ratio $ratio): supervise.py $ours"
 done
 export PRETRAIN=2 RATIO=3
 
