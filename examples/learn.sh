@@ -195,7 +195,7 @@ committed_minutes() {
     | awk '{ t[NR] = $1 } END { if (NR) printf "%.0f min (median of %d committed runs)", t[int((NR + 1) / 2)], NR }'
 }
 if [ "$ROLE" != actor ] && [ ! -f "$run/eval.csv" ]; then
-  log "$task $LABEL seed $SEED: $DEMOS demonstrations, $ENV_STEPS environment steps in chunks of $CHUNK_EPISODES episodes, $PRETRAIN pretraining steps then $RATIO learner steps per agent transition (batch $BATCH, $N_STEP-step targets, tree target K = $TARGET_K), acting with K = $ACT_K; evaluated every $EVAL_EVERY steps on $EVAL_EPISODES held-out scenes${CPU_BUDGET:+, processor budget $CPU_BUDGET s}; networks in $PRECISION${NET_OPTIONS:+, $NET_OPTIONS}"
+  log "$task $LABEL seed $SEED: $DEMOS demonstrations, $ENV_STEPS environment steps in chunks of $CHUNK_EPISODES episodes, $PRETRAIN pretraining steps then $RATIO learner steps per agent transition (batch $BATCH, $N_STEP-step targets, tree target K = $TARGET_K), acting with K = $ACT_K; evaluated every $EVAL_EVERY steps on $EVAL_EPISODES held-out scenes$([ "$CPU_BUDGET" = 0 ] || echo ", processor budget $CPU_BUDGET s")$([ "$TIME_BUDGET" = 0 ] || echo ", wall-clock budget $TIME_BUDGET s"); networks in $PRECISION${NET_OPTIONS:+, $NET_OPTIONS}"
   expected=$(committed_minutes)
   [ -z "$expected" ] || log "$task $LABEL: the committed runs trained for $expected on 2 cores, evaluations excluded"
 fi
