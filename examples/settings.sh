@@ -21,7 +21,9 @@ make_variable_names() {
 }
 
 # For each NAME that is not in KNOWN (a file of names), "NAME" and the known name nearest to it
-# (edit distance at most 2, 1 for names of 5 letters or fewer), or "-": one pair a line.
+# (edit distance at most 2, 1 for names of 5 letters or fewer, and the same first letter: a slip
+# of the first letter is rare, while the system's own variables often differ from a setting
+# just there, as ASAN_OPTIONS and LSAN_OPTIONS from PLAN_OPTIONS), or "-": one pair a line.
 nearest_names() {  # KNOWN_FILE NAME...
   local known=$1; shift
   awk -v names="$*" '
@@ -45,7 +47,10 @@ nearest_names() {  # KNOWN_FILE NAME...
         name = list[k]
         if (name in known) continue
         best = "-"; bestd = length(name) <= 5 ? 2 : 3
-        for (other in known) { dd = distance(name, other); if (dd < bestd || (dd == bestd && other < best)) { best = other; bestd = dd } }
+        for (other in known) {
+          if (substr(other, 1, 1) != substr(name, 1, 1)) continue
+          dd = distance(name, other); if (dd < bestd || (dd == bestd && other < best)) { best = other; bestd = dd }
+        }
         print name, best
       }
     }' "$known"

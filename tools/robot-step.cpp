@@ -87,9 +87,12 @@ static cli::Usage usage() {
        cli::default_text(defaults.reach_tolerance_deg)},
       {"speed", "F", "fraction of each joint's speed limit a motion may use (faster ones are slowed)",
        cli::default_text(defaults.speed_fraction)},
-      {"rate", "HZ", "rows per second of the motions handed to the arm (its servo rate)",
-       cli::default_text(defaults.rate_hz)},
-      {"settle", "S", "seconds after a motion's end before its gripper command", cli::default_text(defaults.settle_s)},
+      cli::real_option("rate", "HZ", "rows per second of the motions handed to the arm (its servo rate)",
+                       cli::default_text(defaults.timing.rate_hz), robot::XarmTiming::kMinRate_hz,
+                       robot::XarmTiming::kMaxRate_hz),
+      cli::real_option("settle", "S", "seconds after a motion's end before its gripper command",
+                       cli::default_text(defaults.timing.settle_s), robot::XarmTiming::kMinSettle_s,
+                       robot::XarmTiming::kMaxSettle_s),
       {"episode-length", "N", "steps per episode (default: the task's, 10 without --task)", ""},
       {"stop-file", "FILE", "stop the robot at once when FILE exists", ""},
       {"motion-timeout", "S", "longest wait for the arm driver's answer", "120"},
@@ -146,8 +149,8 @@ static void run(const cli::Arguments& args) {
   options.workspace = workspace_from(args);
   options.speed_fraction = args.real("speed", 0.01, 1.0);
   options.reach_tolerance_deg = args.real("reach-tolerance", 0.01, 30);
-  options.rate_hz = args.real("rate", 1, 1000);
-  options.settle_s = args.real("settle", 0.01, 10);  // the gripper row needs a time of its own
+  options.timing.rate_hz = args.real("rate");
+  options.timing.settle_s = args.real("settle");
   options.episode_length = args.has("episode-length") ? static_cast<int>(args.integer("episode-length", 1, 1000))
                            : plan ? tasks::make_task(plan->task)->episode_length()
                                   : 10;

@@ -36,10 +36,14 @@ static cli::Usage usage() {
       "as it was, so no arm is given the first moves of an episode whose later ones were refused.",
   };
   u.arguments = {cli::input_files("record streams")};
+  const robot::XarmTiming timing;
   u.options = {
       {"dir", "DIR", "where the files go (created if missing)", "."},
-      {"rate", "HZ", "control rate of the rows (the xArm's servo mode takes up to 250 Hz)", "100"},
-      {"settle", "S", "seconds after the motion at which the gripper command's row comes", "0.5"},
+      cli::real_option("rate", "HZ", "control rate of the rows (the xArm's servo mode takes up to 250 Hz)",
+                       cli::default_text(timing.rate_hz), robot::XarmTiming::kMinRate_hz, robot::XarmTiming::kMaxRate_hz),
+      cli::real_option("settle", "S", "seconds after a motion's end before its gripper command",
+                       cli::default_text(timing.settle_s), robot::XarmTiming::kMinSettle_s,
+                       robot::XarmTiming::kMaxSettle_s),
   };
   u.examples = {
       {"plan-path < episode.rec | xarm-export --dir moves/", "plan each action of a saved episode for the arm"},
@@ -53,7 +57,7 @@ static cli::Usage usage() {
 static void run(const cli::Arguments& args) {
   const std::vector<std::string> files = args.inputs();
   const std::string dir = args.text("dir");
-  const double rate = args.real("rate", 1, 1000), settle = args.real("settle", 0, 60);
+  const double rate = args.real("rate"), settle = args.real("settle");
   OutputDirectory out(dir);
   const robot::RobotModel robot = robot::RobotModel::xarm7();
   robot::XarmEpisode episode(robot, rate, settle);

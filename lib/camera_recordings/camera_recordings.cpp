@@ -1,26 +1,13 @@
 #include "camera_recordings/camera_recordings.hpp"
 
 #include "common/error.hpp"
-#include "robot/pose_values.hpp"
 
 namespace qte::camera_recordings {
 
 namespace {
 
-std::vector<double> row_major(const Eigen::Matrix3d& m) {
-  return {m(0, 0), m(0, 1), m(0, 2), m(1, 0), m(1, 1), m(1, 2), m(2, 0), m(2, 1), m(2, 2)};
-}
-
-std::vector<double> row_major(const Eigen::Isometry3d& t) {
-  std::vector<double> v(16);
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) v[4 * r + c] = t.matrix()(r, c);
-  return v;
-}
-
 void add_pose_fields(stream::Record& obs, const CameraSetup& camera) {
-  if (camera.intrinsics) obs.set<double>(camera.name + ".intrinsics", {3, 3}, row_major(*camera.intrinsics));
-  obs.set<double>(camera.name + ".extrinsics", {4, 4}, row_major(camera.camera_to_world));
+  observation::set_camera_pose(obs, camera.name, camera.intrinsics, camera.camera_to_world);
 }
 
 }  // namespace
@@ -72,33 +59,19 @@ void add_camera_cloud(stream::Record& obs, const CameraSetup& camera, const voxe
   add_pose_fields(obs, camera);
 }
 
-void add_robot_state(stream::Record& obs, const RobotState& state, const robot::RobotModel& robot,
-                     const Eigen::Isometry3d& world_from_base) {
-  const Eigen::Isometry3d tcp = world_from_base * robot.tcp_pose(state.joints);
-  obs.set<double>("joint_positions", {robot::kArmJoints}, state.joints.data());
-  obs.set<double>("joint_velocities", {robot::kArmJoints}, state.joint_velocities_rad_s.data());
-  obs.set<double>("gripper_pose", {robot::kPoseValues}, robot::pose_values(tcp));
-  obs.set_scalar<uint8_t>("gripper_open", gripper_is_open(state, robot));
-  obs.set_scalar<double>("gripper_opening_m", state.gripper_opening_m);
+observation::ArmState arm_state(const RobotState& state, const robot::RobotModel& robot,
+                               const Eigen::Isometry3d& world_from_base) {
+  observation::ArmState arm;
+  arm.joints = state.joints;
+  arm.velocities_rad_s = state.joint_velocities_rad_s;
+  arm.tool_in_world = world_from_base * robot.tcp_pose(state.joints);
+  arm.gripper_open = gripper_is_open(state, robot);
+  arm.gripper_opening_m = state.gripper_opening_m;
+  return arm;
 }
 
 bool gripper_is_open(const RobotState& state, const robot::RobotModel& robot) {
   return state.gripper_open.value_or(state.gripper_opening_m > robot.max_finger_opening_m() / 2);
-}
-
-void add_episode_fields(stream::Record& obs, int step, int episode_length, const std::string& task) {
-  obs.set_scalar<int32_t>("step", step);
-  obs.set_scalar<int32_t>("frame", step);
-  obs.set_scalar<int32_t>("episode_length", episode_length);
-  obs.set_scalar<double>("time_s", 0.0);
-  obs.set_scalar<float>("reward", 0.0f);
-  obs.set_scalar<uint8_t>("terminal", 0);
-  obs.set_scalar<uint8_t>("success", 0);
-  obs.set_scalar<uint8_t>("ignore_collisions", 0);
-  obs.set_string("task", task);
-  obs.set_string("description", "");
-  obs.set_scalar<int32_t>("variation", 0);
-  obs.set_scalar<int64_t>("episode_seed", 0);
 }
 
 }  // namespace qte::camera_recordings

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "observation/observation.hpp"
 #include "robot/robot_model.hpp"
 #include "stream/record.hpp"
 #include "voxels/observation_cloud.hpp"
@@ -46,15 +47,11 @@ void add_camera_images(stream::Record& obs, const CameraSetup& camera, const cv:
 // it): <name>.points in the world frame, <name>.rgb, and the intrinsics when set.
 void add_camera_cloud(stream::Record& obs, const CameraSetup& camera, const voxels::CameraCloud& cloud);
 
-// joint_positions, joint_velocities, gripper_pose (forward kinematics), gripper_open (the
-// state's, else fingers more than half open), gripper_opening_m.
-void add_robot_state(stream::Record& obs, const RobotState& state, const robot::RobotModel& robot,
-                     const Eigen::Isometry3d& world_from_base);
+// The arm's fields of an observation (observation::set_arm_state) from a recorded state: the
+// gripper's pose by forward kinematics, gripper_open the state's, else fingers more than half open.
+observation::ArmState arm_state(const RobotState& state, const robot::RobotModel& robot,
+                               const Eigen::Isometry3d& world_from_base);
 bool gripper_is_open(const RobotState& state, const robot::RobotModel& robot);
-
-// step, frame, episode_length, task, description, and an episode that has not ended
-// (reward 0, terminal 0, success 0, ignore_collisions 0, variation 0, episode_seed 0).
-void add_episode_fields(stream::Record& obs, int step, int episode_length, const std::string& task);
 
 // A CSV with one row per frame: 7 joint angles in radians, optionally the gripper opening in
 // metres as an 8th column; a first row with no number in it is a header (nan and inf are

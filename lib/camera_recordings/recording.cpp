@@ -9,6 +9,7 @@
 
 #include "camera_recordings/png_frames.hpp"
 #include "common/error.hpp"
+#include "observation/observation.hpp"
 #include "keyframes/keyframes.hpp"
 #include "point_clouds/pcd_file.hpp"
 #include "robot/pose_values.hpp"
@@ -136,26 +137,29 @@ PackedRecording pack_recording(const Recording& recording, const robot::RobotMod
     } else {
       add_camera_cloud(obs, recording.camera, point_clouds::read_pcd(first));
     }
+    observation::ArmState arm;  // without a joint log: the gripper open, nothing else known
+    arm.gripper_opening_m = robot.max_finger_opening_m();
     if (has_states) {
       if (packed.written >= static_cast<int64_t>(recording.states.size()))
         throw Error(recording.joints_path + ": no row for frame " + std::to_string(index) + " (" +
                     std::to_string(recording.states.size()) + " rows)");
-      add_robot_state(obs, recording.states[packed.written], robot, world::SceneLayout{}.robot_base_pose());
-    } else {
-      obs.set_scalar<uint8_t>("gripper_open", 1);
-      obs.set_scalar<double>("gripper_opening_m", robot.max_finger_opening_m());
+      arm = arm_state(recording.states[packed.written], robot, world::SceneLayout{}.robot_base_pose());
     }
-    add_episode_fields(obs, static_cast<int>(packed.written), recording.episode_length, recording.task);
-    if (!recording.times_s.empty()) obs.set_scalar<double>("time_s", recording.times_s.at(packed.written));
+    observation::set_arm_state(obs, arm);
+    observation::EpisodeState episode;  // an episode that has not ended, unless a demonstration's last frame
+    episode.step = episode.frame = static_cast<int>(packed.written);
+    episode.episode_length = recording.episode_length;
+    episode.task = recording.task;
+    if (!recording.times_s.empty()) episode.time_s = recording.times_s.at(packed.written);
     if (recording.demonstration_success) {
-      obs.set_scalar<int32_t>("step", steps[packed.written]);
+      episode.step = steps[packed.written];
       if (packed.written + 1 == count) {
-        const bool success = *recording.demonstration_success;
-        obs.set_scalar<float>("reward", success ? tasks::kSuccessReward : 0.0f);
-        obs.set_scalar<uint8_t>("terminal", 1);
-        obs.set_scalar<uint8_t>("success", success);
+        episode.success = *recording.demonstration_success;
+        episode.reward = episode.success ? tasks::kSuccessReward : 0.0f;
+        episode.terminal = true;
       }
     }
+    observation::set_episode_state(obs, episode);
     const voxels::ObservationCloud cloud = voxels::observation_cloud(obs);
     if (voxels::points_inside(cloud.view(), voxels::GridBounds{}) == 0) packed.blind += 1;
     emit(obs);

@@ -68,7 +68,10 @@ std::string option_label(const OptionSpec& o) {
 std::string option_help(const OptionSpec& o) {
   std::string h = o.help;
   if (o.required) h += " (required)";
-  if (!o.default_value.empty()) h += " (default: " + o.default_value + ")";
+  const std::string range = o.number != OptionSpec::Number::none ? range_text(o) : "";
+  if (!range.empty() && !o.default_value.empty()) h += " (" + range + "; default: " + o.default_value + ")";
+  else if (!range.empty()) h += " (" + range + ")";
+  else if (!o.default_value.empty()) h += " (default: " + o.default_value + ")";
   if (o.repeatable) h += "; may be repeated";
   return h;
 }
@@ -164,7 +167,7 @@ std::string Arguments::text(const std::string& name) const {
   return o->default_value;
 }
 
-int64_t Arguments::integer(const std::string& name) const {
+int64_t Arguments::parse_integer(const std::string& name) const {
   const std::string v = text(name);
   try {
     std::size_t used = 0;
@@ -176,13 +179,13 @@ int64_t Arguments::integer(const std::string& name) const {
 }
 
 int64_t Arguments::integer(const std::string& name, int64_t lo, int64_t hi) const {
-  const int64_t n = integer(name);
+  const int64_t n = parse_integer(name);
   if (n < lo || n > hi)
     throw UsageError("--" + name + " must be " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " + text(name));
   return n;
 }
 
-double Arguments::real(const std::string& name) const {
+double Arguments::parse_real(const std::string& name) const {
   const std::string v = text(name);
   try {
     std::size_t used = 0;
@@ -194,13 +197,67 @@ double Arguments::real(const std::string& name) const {
 }
 
 double Arguments::real(const std::string& name, double lo, double hi) const {
-  const double x = real(name);
+  const double x = parse_real(name);
   if (!std::isfinite(x) || x < lo || x > hi) {
     std::ostringstream range;
     range << lo << ".." << hi;
     throw UsageError("--" + name + " must be " + range.str() + ", got " + text(name));
   }
   return x;
+}
+
+const OptionSpec& Arguments::ranged(const std::string& name, OptionSpec::Number number) const {
+  const OptionSpec* o = find_option(usage_->options, name);  // a tool's own: common options have no range
+  if (!o || o->number != number) throw Error("internal: option --" + name + " is not declared with its range");
+  return *o;
+}
+
+int64_t Arguments::integer(const std::string& name) const {
+  const OptionSpec& o = ranged(name, OptionSpec::Number::integer);
+  return integer(name, static_cast<int64_t>(o.low), static_cast<int64_t>(o.high));
+}
+
+double Arguments::real(const std::string& name) const {
+  const OptionSpec& o = ranged(name, OptionSpec::Number::real);
+  return real(name, o.low, o.high);
+}
+
+OptionSpec integer_option(std::string name, std::string value_name, std::string help, std::string default_value,
+                          int64_t low, int64_t high) {
+  OptionSpec o{std::move(name), std::move(value_name), std::move(help), std::move(default_value)};
+  o.number = OptionSpec::Number::integer;
+  o.low = static_cast<double>(low);
+  o.high = static_cast<double>(high);
+  return o;
+}
+
+OptionSpec real_option(std::string name, std::string value_name, std::string help, std::string default_value,
+                       double low, double high) {
+  OptionSpec o{std::move(name), std::move(value_name), std::move(help), std::move(default_value)};
+  o.number = OptionSpec::Number::real;
+  o.low = low;
+  o.high = high;
+  return o;
+}
+
+std::string range_text(const OptionSpec& o) {
+  if (o.number == OptionSpec::Number::integer)
+    return std::to_string(static_cast<int64_t>(o.low)) + ".." + std::to_string(static_cast<int64_t>(o.high));
+  std::ostringstream range;
+  range << o.low << ".." << o.high;
+  return range.str();
+}
+
+void check_range(const std::vector<OptionSpec>& options, const std::string& name, double value,
+                 const std::string& where) {
+  const OptionSpec* o = find_option(options, name);
+  if (!o || o->number == OptionSpec::Number::none) throw Error("internal: option --" + name + " has no declared range");
+  if (!std::isfinite(value) || value < o->low || value > o->high) {
+    std::ostringstream got;
+    got.precision(17);
+    got << value;
+    throw Error(where + ": " + name + " must be " + range_text(*o) + " (--" + name + "), got " + got.str());
+  }
 }
 
 std::string default_text(int64_t value) { return std::to_string(value); }

@@ -18,7 +18,25 @@ struct OptionSpec {
   std::string default_value;  // shown in help; used when the option is absent
   bool repeatable = false;    // may be given several times (values collected in order)
   bool required = false;      // parse() refuses a command line without it
+  // A number's type and range, declared with the option (integer_option, real_option): the
+  // one-argument Arguments::integer and real check them, --help and the man page show them, and
+  // check_range holds a value from elsewhere (a checkpoint's settings) to the same range.
+  enum class Number { none, integer, real } number = Number::none;
+  double low = 0, high = 0;
 };
+
+// Options whose value is a number in low..high; `default_value` as default_text gives it from
+// the setting's struct (empty: none).
+OptionSpec integer_option(std::string name, std::string value_name, std::string help, std::string default_value,
+                          int64_t low, int64_t high);
+OptionSpec real_option(std::string name, std::string value_name, std::string help, std::string default_value,
+                       double low, double high);
+// "1..100000", "0..1", "1e-12..1e+30": a declared range as --help and the errors write it.
+std::string range_text(const OptionSpec& option);
+// A value of the ranged option `name` (one of `options`) that did not come from the command line:
+// an Error naming the option and `where` unless it lies in the declared range.
+void check_range(const std::vector<OptionSpec>& options, const std::string& name, double value,
+                 const std::string& where);
 
 struct ArgumentSpec {
   std::string name;  // "FILE"
@@ -75,6 +93,9 @@ class Arguments {
   // when a tool narrows it), or a real that is not finite or outside lo..hi, is a UsageError.
   int64_t integer(const std::string& name, int64_t lo, int64_t hi) const;
   double real(const std::string& name, double lo, double hi) const;
+  // The same within the range declared with the option (integer_option, real_option).
+  int64_t integer(const std::string& name) const;
+  double real(const std::string& name) const;
   // "LO,HI": two finite numbers, LO < HI.
   std::pair<double, double> range(const std::string& name) const;
   // "WxH" with W in min_width..max_width and H in min_height..max_height.
@@ -96,8 +117,9 @@ class Arguments {
   uint64_t seed() const { return static_cast<uint64_t>(integer("seed", 0, INT64_MAX)); }
 
  private:
-  int64_t integer(const std::string& name) const;
-  double real(const std::string& name) const;
+  int64_t parse_integer(const std::string& name) const;
+  double parse_real(const std::string& name) const;
+  const OptionSpec& ranged(const std::string& name, OptionSpec::Number number) const;
   friend Arguments parse(const Usage& usage, const std::vector<std::string>& argv);
   const Usage* usage_ = nullptr;
   std::map<std::string, std::vector<std::string>> given_;

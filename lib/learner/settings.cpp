@@ -1,6 +1,8 @@
 #include "learner/settings.hpp"
 
+#include "learner/learner_options.hpp"
 #include "qattention/branching_options.hpp"
+#include "voxels/hierarchy_options.hpp"
 
 #include <algorithm>
 #include <sstream>
@@ -29,17 +31,25 @@ std::string LearnerConfig::json() const {
 }
 
 void LearnerConfig::validate() const {
-  if (batch < 1) throw UsageError("--batch must be at least 1");
-  if (!(gamma >= 0 && gamma <= 1)) throw UsageError("--gamma must be in [0, 1]");
-  if (!(tau >= 0 && tau <= 1)) throw UsageError("--tau must be in [0, 1]");
-  if (!(learning_rate > 0)) throw UsageError("--lr must be positive");
-  if (!(weight_decay >= 0) || !(grad_clip_value >= 0) || !(grad_clip_norm >= 0) || !(q_regularisation >= 0) ||
-      !(huber_delta > 0) || !(reward_scale > 0))
-    throw UsageError("--weight-decay, --grad-clip-value, --grad-clip-norm and --q-reg must be >= 0; "
-                     "--huber-delta, --reward-scale > 0");
-  if (tree_target_k < 0) throw UsageError("--tree-target must be >= 0");
-  if (n_step < 1 || n_step > 10) throw UsageError("--n-step must be 1-10");
-  if (hierarchy.depths < 1 || hierarchy.depths > 8) throw UsageError("--depths must be 1-8");
+  // The ranges are the options' own (learner_config_options): a configuration from the command
+  // line has passed them already; one from elsewhere (a checkpoint) is held to them here.
+  const std::vector<cli::OptionSpec> options = learner_config_options();
+  const std::pair<const char*, double> values[] = {
+      {"batch", batch},
+      {"gamma", gamma},
+      {"reward-scale", reward_scale},
+      {"tau", tau},
+      {"lr", learning_rate},
+      {"weight-decay", weight_decay},
+      {"grad-clip-value", grad_clip_value},
+      {"grad-clip-norm", grad_clip_norm},
+      {"q-reg", q_regularisation},
+      {"huber-delta", huber_delta},
+      {"n-step", static_cast<double>(n_step)},
+  };
+  for (const auto& [name, value] : values) cli::check_range(options, name, value, "the learner's settings");
+  if (tree_target_k < 0) throw Error("the learner's settings: tree_target_k must be >= 0, got " + std::to_string(tree_target_k));
+  cli::check_range(voxels::hierarchy_options(), "depths", hierarchy.depths, "the learner's settings");
   try {
     hierarchy.validate();
   } catch (const Error& e) {

@@ -13,6 +13,14 @@ namespace qte::robot {
 
 constexpr double kXarmGripperOpenUnits = 850.0;  // the xArm gripper's position at its widest
 
+// When the rows of a motion come (xarm-export's and robot-step's --rate and --settle).
+struct XarmTiming {
+  double rate_hz = 100;   // the control rate (the xArm's servo mode takes up to 250 Hz)
+  double settle_s = 0.5;  // after a motion's end, the gripper command's row
+  // The options' ranges: the gripper's row needs a time of its own after the motion's last.
+  static constexpr double kMinRate_hz = 1, kMaxRate_hz = 1000, kMinSettle_s = 0.01, kMaxSettle_s = 10;
+};
+
 struct XarmRow {
   double time_s = 0;
   JointVector degrees = JointVector::Zero();
@@ -24,7 +32,7 @@ struct XarmRow {
 // after the end, commands `gripper_after_m`. Throws Error with joint_path_failure()'s reason,
 // checked on the waypoints and again on the rows.
 std::vector<XarmRow> xarm_rows(const double* time_s, const double* joints, int64_t n, double gripper_before_m,
-                               double gripper_after_m, const RobotModel& robot, double rate_hz, double settle_s = 0.5);
+                               double gripper_after_m, const RobotModel& robot, double rate_hz, double settle_s);
 
 // The motions of an episode in order, as xarm_rows() of each: during a motion the gripper holds
 // what the last observation said (open before any observation), or what the motion before it

@@ -7,6 +7,7 @@
 #include "camera_recordings/png_frames.hpp"
 #include "cli/command.hpp"
 #include "common/error.hpp"
+#include "observation/observation.hpp"
 #include "planning/collision_checker.hpp"
 #include "robot/joint_path.hpp"
 #include "tasks/task.hpp"
@@ -149,23 +150,27 @@ stream::Record RobotWorld::observe() {
   camera_recordings::RobotState state;  // at rest: a motion has ended before each frame
   state.joints = joints_;
   state.gripper_opening_m = gripper_m_;
-  camera_recordings::add_robot_state(obs, state, robot_, world_from_base_);
+  observation::set_arm_state(obs, camera_recordings::arm_state(state, robot_, world_from_base_));
   last_frame_ = frame.colour_png;
   return obs;
 }
 
 void RobotWorld::set_episode_fields(stream::Record& obs, const std::string& failure) {
-  camera_recordings::add_episode_fields(obs, step_, options_.episode_length, episode_.task);
-  obs.set_scalar<int32_t>("frame", frame_++);
-  obs.set_scalar<double>("time_s", time_s_);
-  obs.set_scalar<float>("reward", success_ ? tasks::kSuccessReward : 0.0f);
-  obs.set_scalar<uint8_t>("terminal", terminal_);
-  obs.set_scalar<uint8_t>("success", success_);
-  obs.set_scalar<int32_t>("variation", episode_.variation);
-  obs.set_scalar<int64_t>("episode_seed", episode_.seed);
-  obs.set_scalar<uint8_t>("ignore_collisions", ignore_collisions_);
-  obs.set_string("description", description_);
-  if (!failure.empty()) obs.set_string("failure", failure);
+  observation::EpisodeState episode;
+  episode.step = step_;
+  episode.episode_length = options_.episode_length;
+  episode.frame = frame_++;
+  episode.time_s = time_s_;
+  episode.reward = success_ ? tasks::kSuccessReward : 0.0f;
+  episode.terminal = terminal_;
+  episode.success = success_;
+  episode.task = episode_.task;
+  episode.variation = episode_.variation;
+  episode.episode_seed = episode_.seed;
+  episode.description = description_;
+  episode.ignore_collisions = ignore_collisions_;
+  episode.failure = failure;
+  observation::set_episode_state(obs, episode);
 }
 
 void RobotWorld::reset(const stream::Record& record, const stream::Emit& emit) {
@@ -221,8 +226,8 @@ std::string RobotWorld::check_motion(const stream::Record& record, std::vector<r
                          : record.scalar<uint8_t>("gripper_open") ? robot_.max_finger_opening_m()
                                                                   : 0.0;
   try {
-    rows = robot::xarm_rows(stretched.data(), path.joints, path.n, gripper_m_, after_m, robot_, options_.rate_hz,
-                            options_.settle_s);
+    rows = robot::xarm_rows(stretched.data(), path.joints, path.n, gripper_m_, after_m, robot_, options_.timing.rate_hz,
+                            options_.timing.settle_s);
   } catch (const Error& e) {
     return std::string("invalid_trajectory:") + e.what();
   }

@@ -31,7 +31,7 @@ struct RobotOptions {
   // A driver's reached joints further than this from the motion's last row are a fault.
   double reach_tolerance_deg = 2.0;
   double speed_fraction = 1.0;  // of each joint's speed limit; slower motions are stretched in time
-  double rate_hz = 100, settle_s = 0.5;  // the rows the driver streams (xarm-export's)
+  robot::XarmTiming timing;  // the rows the driver streams (xarm-export's)
   int episode_length = 10;
   bool dry_run = false;     // write no motion: print it, and take it as done
   bool compress = false;    // zstd on the camera arrays

@@ -11,6 +11,7 @@
 #include "common/atomic_file.hpp"
 #include "common/error.hpp"
 #include "common/random.hpp"
+#include "observation/observation.hpp"
 #include "robot/joint_path.hpp"
 #include "robot/pose_values.hpp"
 
@@ -19,15 +20,6 @@ namespace {
 
 constexpr double kStartTolerance_rad = 1e-3;  // a trajectory must start where the arm is
 constexpr double kSettleAfterRelease_s = 0.5;  // physics after opening on a held object
-
-// Flattens an Eigen matrix row-major (the stream's C order).
-template <class Matrix>
-std::vector<double> row_major(const Matrix& m) {
-  std::vector<double> v;
-  for (int r = 0; r < m.rows(); ++r)
-    for (int c = 0; c < m.cols(); ++c) v.push_back(m(r, c));
-  return v;
-}
 
 }  // namespace
 
@@ -83,28 +75,30 @@ stream::Record Simulator::observe(const std::string& failure) {
     obs.set<uint8_t>(n + ".rgb", {h, w, 3}, frame.rgb.ptr<uint8_t>(), z);
     obs.set<float>(n + ".depth", {h, w}, frame.depth.ptr<float>(), z);
     if (options_.point_clouds) obs.set<float>(n + ".points", {h, w, 3}, frame.points.ptr<float>(), z);
-    obs.set<double>(n + ".intrinsics", {3, 3}, row_major(frame.intrinsics));
-    obs.set<double>(n + ".extrinsics", {4, 4}, row_major(frame.world_from_camera.matrix()));
+    observation::set_camera_pose(obs, n, frame.intrinsics, frame.world_from_camera);
   }
-  const robot::JointVector& q = world_->joint_positions();
-  obs.set<double>("joint_positions", {7}, q.data());
-  obs.set<double>("joint_velocities", {7}, velocity_.data());
-  obs.set<double>("gripper_pose", {robot::kPoseValues}, robot::pose_values(world_->tcp_pose()));
-  obs.set_scalar<uint8_t>("gripper_open", world_->gripper_open());
-  obs.set_scalar<double>("gripper_opening_m", world_->finger_opening_m());
-  obs.set_scalar<int32_t>("step", step_);
-  obs.set_scalar<int32_t>("episode_length", task_->episode_length());
-  obs.set_scalar<int32_t>("frame", frame_++);
-  obs.set_scalar<double>("time_s", time_s_);
-  obs.set_scalar<float>("reward", success_ ? tasks::kSuccessReward : 0.0f);
-  obs.set_scalar<uint8_t>("terminal", terminal_);
-  obs.set_scalar<uint8_t>("success", success_);
-  obs.set_string("task", task_name_);
-  obs.set_scalar<int32_t>("variation", variation_);
-  obs.set_scalar<int64_t>("episode_seed", episode_seed_);
-  obs.set_string("description", task_->description(variation_));
-  obs.set_scalar<uint8_t>("ignore_collisions", ignore_collisions_);
-  if (!failure.empty()) obs.set_string("failure", failure);
+  observation::ArmState arm;
+  arm.joints = world_->joint_positions();
+  arm.velocities_rad_s = velocity_;
+  arm.tool_in_world = world_->tcp_pose();
+  arm.gripper_open = world_->gripper_open();
+  arm.gripper_opening_m = world_->finger_opening_m();
+  observation::set_arm_state(obs, arm);
+  observation::EpisodeState episode;
+  episode.step = step_;
+  episode.episode_length = task_->episode_length();
+  episode.frame = frame_++;
+  episode.time_s = time_s_;
+  episode.reward = success_ ? tasks::kSuccessReward : 0.0f;
+  episode.terminal = terminal_;
+  episode.success = success_;
+  episode.task = task_name_;
+  episode.variation = variation_;
+  episode.episode_seed = episode_seed_;
+  episode.description = task_->description(variation_);
+  episode.ignore_collisions = ignore_collisions_;
+  episode.failure = failure;
+  observation::set_episode_state(obs, episode);
   if (options_.object_poses) set_object_fields(obs, *world_);
   return obs;
 }

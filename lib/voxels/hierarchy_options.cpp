@@ -10,6 +10,7 @@ const char* kVoxelsHelp = "voxels per side of every grid";
 const char* kBoundsHelp = "scene bounds: minimum corner and edge length in metres";
 const char* kDepthsHelp = "coarse-to-fine depths";
 const char* kOffsetHelp = "half edge of the grids of each depth below 0, metres (one per depth: 0.15,0.05 for 3)";
+constexpr int kMaxDepths = 8;
 
 // Errors of the values (a negative offset, an offset count that does not match) are usage errors.
 template <typename Parse>
@@ -25,10 +26,24 @@ auto as_usage_error(Parse parse) {
 
 }  // namespace
 
+// "X,Y,Z,S" as --bounds takes it.
+std::string bounds_text(const GridBounds& bounds) {
+  std::string text;
+  for (double v : bounds_values(bounds)) text += (text.empty() ? "" : ",") + cli::default_text(v);
+  return text;
+}
+
+// "0.15" or "0.15,0.05" as --offset takes it.
+std::string offsets_text(const std::vector<double>& offsets_m) {
+  std::string text;
+  for (double v : offsets_m) text += (text.empty() ? "" : ",") + cli::default_text(v);
+  return text;
+}
+
 std::vector<cli::OptionSpec> scene_options() {
   const CoarseToFine published;
-  return {{"voxels", "V", kVoxelsHelp, std::to_string(published.voxels())},
-          {"bounds", "X,Y,Z,S", kBoundsHelp, "-0.3,-0.5,0.6,1.0"}};
+  return {{"voxels", "V", kVoxelsHelp, cli::default_text(published.voxels())},
+          {"bounds", "X,Y,Z,S", kBoundsHelp, bounds_text(published.scene)}};
 }
 
 GridBounds parse_scene(const cli::Arguments& args, int min_voxels, int max_voxels) {
@@ -38,14 +53,17 @@ GridBounds parse_scene(const cli::Arguments& args, int min_voxels, int max_voxel
 
 std::vector<cli::OptionSpec> hierarchy_options() {
   std::vector<cli::OptionSpec> options = scene_options();
-  options.insert(options.begin() + 1, {{"depths", "D", kDepthsHelp, "2"}, {"offset", "M[,M...]", kOffsetHelp, "0.15"}});
+  const CoarseToFine published;
+  options.insert(options.begin() + 1,
+                 {cli::integer_option("depths", "D", kDepthsHelp, cli::default_text(published.depths), 1, kMaxDepths),
+                  {"offset", "M[,M...]", kOffsetHelp, offsets_text(published.offsets_m)}});
   return options;
 }
 
 CoarseToFine parse_hierarchy(const cli::Arguments& args, int min_voxels, int max_voxels) {
   CoarseToFine hierarchy;
   hierarchy.scene = parse_scene(args, min_voxels, max_voxels);
-  hierarchy.depths = static_cast<int>(args.integer("depths", 1, 8));
+  hierarchy.depths = static_cast<int>(args.integer("depths"));
   hierarchy.offsets_m = as_usage_error([&] { return CoarseToFine::parse_offsets(args.text("offset"), hierarchy.depths); });
   return hierarchy;
 }
@@ -63,13 +81,13 @@ std::vector<cli::OptionSpec> checkpoint_hierarchy_options() {
 
 CoarseToFine checkpoint_hierarchy(const cli::Arguments& args, const std::optional<CoarseToFine>& trained, int voxels,
                                   int depths, const std::string& checkpoint) {
-  const auto agree = [&](const char* option, int checkpoint_value) {
-    if (args.has(option) && args.integer(option, 1, 1 << 20) != checkpoint_value)
+  const auto agree = [&](const char* option, int64_t given, int checkpoint_value) {
+    if (given != checkpoint_value)
       throw UsageError(std::string("--") + option + " " + args.text(option) + " differs from the checkpoint's " +
                        std::to_string(checkpoint_value) + " (" + checkpoint + ")");
   };
-  agree("voxels", voxels);
-  agree("depths", depths);
+  if (args.has("voxels")) agree("voxels", args.integer("voxels", 1, 1 << 20), voxels);  // the checkpoint says which
+  if (args.has("depths")) agree("depths", args.integer("depths"), depths);
   CoarseToFine hierarchy = trained.value_or(CoarseToFine{});
   hierarchy.depths = depths;
   hierarchy.scene.voxels = voxels;

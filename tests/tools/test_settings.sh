@@ -34,7 +34,7 @@ refused "METHOD=qtee|one of qte, c2farm, adaptive" -- METHOD=qtee
 refused "IMAGE=128|WIDTHxHEIGHT" -- IMAGE=128
 task=reach_targe refused "reach_targe is not a task|reach_target" -- SEED=0
 # Names of the system that are near no setting pass (the shell's, make's); so do settings.
-HOME_DIR=x LANGUAGE=en bash -c ". '$src/examples/common.sh'; . '$src/examples/settings.sh'; settings_load test" \
+HOME_DIR=x LANGUAGE=en ASAN_OPTIONS=x LSAN_OPTIONS=x TSAN_OPTIONS=x bash -c ". '$src/examples/common.sh'; . '$src/examples/settings.sh'; settings_load test" \
   || fail "settings_load refused ordinary environment variables"
 defaults=$(bash -c ". '$src/examples/common.sh'; . '$src/examples/settings.sh'; METHOD=c2farm; settings_load test; echo \$ACT_K \$TARGET_K \$LABEL \$STAGE")
 [ "$defaults" = "1 0 c2farm-k1-t0 sim-step --image-size 128x128" ] || fail "defaults from the settings above: $defaults"

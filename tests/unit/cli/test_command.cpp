@@ -105,3 +105,42 @@ TEST(Command, RequiredOptionsChoicesAndInputs) {
   EXPECT_NE(help.find("networks (required)"), std::string::npos);
   EXPECT_NE(help.find("'-' or absent is standard input"), std::string::npos);
 }
+
+// An option declared with its type and range: the one-argument readers check that range, the help
+// shows it, and check_range holds a value from elsewhere to it; reading it as another type, or an
+// option declared without a range, is a programming error.
+TEST(Command, RangesDeclaredWithTheOption) {
+  cli::Usage u = usage();
+  u.options.push_back(cli::integer_option("batch", "B", "transitions per step", "32", 1, 100000));
+  u.options.push_back(cli::real_option("gamma", "G", "discount", "0.99", 0, 1));
+  EXPECT_EQ(cli::parse(u, {}).integer("batch"), 32);
+  EXPECT_DOUBLE_EQ(cli::parse(u, {"--gamma", "0.5"}).real("gamma"), 0.5);
+  EXPECT_EQ(cli::parse(u, {"--batch", "100000"}).integer("batch"), 100000);
+  for (const char* bad : {"0", "100001", "-3", "1.5", "x"})
+    EXPECT_THROW(cli::parse(u, {"--batch", bad}).integer("batch"), UsageError) << bad;
+  for (const char* bad : {"-0.01", "1.01", "nan", "inf"})
+    EXPECT_THROW(cli::parse(u, {"--gamma", bad}).real("gamma"), UsageError) << bad;
+  try {
+    cli::parse(u, {"--gamma", "2"}).real("gamma");
+    FAIL() << "--gamma 2 accepted";
+  } catch (const UsageError& e) {
+    EXPECT_EQ(std::string(e.what()), "--gamma must be 0..1, got 2");
+  }
+  const cli::Arguments a = cli::parse(u, {});
+  EXPECT_THROW(a.real("batch"), Error);  // declared an integer
+  EXPECT_THROW(a.integer("k"), Error);   // declared without a range
+  const std::string help = cli::help_text(u);
+  EXPECT_NE(help.find("transitions per step (1..100000; default: 32)"), std::string::npos) << help;
+  EXPECT_NE(help.find("discount (0..1; default: 0.99)"), std::string::npos) << help;
+  EXPECT_EQ(cli::range_text(u.options.back()), "0..1");
+
+  EXPECT_NO_THROW(cli::check_range(u.options, "gamma", 1.0, "a checkpoint"));
+  EXPECT_THROW(cli::check_range(u.options, "gamma", std::nan(""), "a checkpoint"), Error);
+  try {
+    cli::check_range(u.options, "batch", 0, "ckpt.rec's settings");
+    FAIL() << "batch 0 accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), "ckpt.rec's settings: batch must be 1..100000 (--batch), got 0");
+  }
+  EXPECT_THROW(cli::check_range(u.options, "k", 5, "x"), Error);  // no range declared
+}
