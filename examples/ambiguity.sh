@@ -12,10 +12,10 @@ here=$(cd "$(dirname "$0")" && pwd)
 source "$here/common.sh"
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 demo-record --task "$task" --episodes 1 --seed "$seed" --image-size "$image" --objects --output "$tmp/demo.rec" 2>/dev/null
-centres=$("$PYTHON" "$here/ambiguity.py" "$around" "$tmp/demo.rec")
+centres=$("$PYTHON" "$here/analysis/ambiguity.py" "$around" "$tmp/demo.rec")
 args=(); for c in $centres; do args+=(--centre "$c"); done
 stream-cat --type obs --head 1 "$tmp/demo.rec" | voxelize "${args[@]}" --png "$tmp/png" --output "$tmp/voxels.rec"
-"$PYTHON" "$here/ambiguity.py" compare "$tmp/voxels.rec"
+"$PYTHON" "$here/analysis/ambiguity.py" compare "$tmp/voxels.rec"
 images=$here/images
 cp "$tmp/png/000000.depth0.png" "$images/${task}_depth0.png"
 cp "$tmp/png/000000.depth1.0.png" "$images/${task}_depth1_target.png"

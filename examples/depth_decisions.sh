@@ -25,5 +25,5 @@ agent_loop "$tmp/loop" \
   qte-select --checkpoint "$checkpoint" --k "$k" "$@" --threads 1 ${PICTURES:+--png "$PICTURES/attention"} \
   plan-path ${PLAN_OPTIONS:-} > "$agent"
 if [ -n "${PICTURES:-}" ]; then stream-png --dir "$PICTURES/frames" "$agent"; fi
-"$PYTHON" "$here/depth_decisions.py" --label "$label" ${DECISION_STEP:+--step "$DECISION_STEP"} \
+"$PYTHON" "$here/analysis/depth_decisions.py" --label "$label" ${DECISION_STEP:+--step "$DECISION_STEP"} \
   ${PICTURES:+--actions "$PICTURES/actions.csv"} "$agent"

@@ -51,5 +51,5 @@ agent_loop "$tmp/loop" \
   sim-step "${scenes[@]}" --objects \
   qte-select "${agent[@]}" "$@" \
   plan-path ${PLAN_OPTIONS:-} > "$tmp/agent.rec"
-"$PYTHON" "$here/failure_reasons.py" --label "$label" --seed "$seed" ${FAILURE_EPISODES:+--episodes} \
+"$PYTHON" "$here/analysis/failure_reasons.py" --label "$label" --seed "$seed" ${FAILURE_EPISODES:+--episodes} \
   "$experts" "$tmp/agent.rec"

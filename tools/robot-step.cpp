@@ -40,7 +40,7 @@ static cli::Usage usage() {
       "with the joints it reached or a fault; after each motion a camera recorder answers a "
       "capture request with a colour and a 16-bit depth PNG, read as obs-pack reads them with "
       "the camera's calibration (--intrinsics, --camera-pose or --extrinsics, in the "
-      "simulation's world frame). examples/xarm_driver.py and examples/realsense_recorder.py "
+      "simulation's world frame). examples/robot/xarm_driver.py and examples/robot/realsense_recorder.py "
       "are such drivers.",
       "Safety first: every motion is checked before it is written: finite, starting where the "
       "arm is, within the joint limits, no joint faster than --speed of its limit (slower "

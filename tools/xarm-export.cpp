@@ -30,7 +30,7 @@ static cli::Usage usage() {
       "rows: finite, time starting at 0 and increasing, at most 60 s, within the xArm 7's joint "
       "limits, and no joint faster than its 180 deg/s limit. A path that fails is an error "
       "naming the record and the reason; a 'trajectory' that holds only a planner failure has no "
-      "motion and is skipped with a line on standard error. examples/xarm_play.py plays the "
+      "motion and is skipped with a line on standard error. examples/robot/xarm_play.py plays the "
       "files on the arm with UFACTORY's Python SDK.",
       "The files appear all or none: a run that fails (a path refused, damaged input) leaves DIR "
       "as it was, so no arm is given the first moves of an episode whose later ones were refused.",
@@ -47,7 +47,7 @@ static cli::Usage usage() {
   };
   u.examples = {
       {"plan-path < episode.rec | xarm-export --dir moves/", "plan each action of a saved episode for the arm"},
-      {"python3 examples/xarm_play.py --ip 192.168.1.185 moves/000004.xarm.csv", "play one move on the robot"},
+      {"python3 examples/robot/xarm_play.py --ip 192.168.1.185 moves/000004.xarm.csv", "play one move on the robot"},
   };
   u.see_also = {"plan-path(1)", "sim-step(1)", "qte-stream(5)"};
   u.environment = robot::kDataDirEnvironment;

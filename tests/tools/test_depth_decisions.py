@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""examples/depth_decisions.py on a scene built here, where every answer is known: a target
+"""examples/analysis/depth_decisions.py on a scene built here, where every answer is known: a target
 block, a lookalike turned 45 degrees and a zone (other) at known poses. Voxel centres are
 judged as the rule says (on the box, within half a voxel of it, above it, beside the turned
 box's corner, on the zone: elsewhere); a stream of actions gives the table by depth, the
@@ -14,7 +14,7 @@ import tempfile
 import numpy as np
 
 SOURCE = os.environ.get("QTE_SOURCE") or os.path.join(os.path.dirname(__file__), "..", "..")
-sys.path.insert(0, os.path.join(SOURCE, "examples"))
+sys.path.insert(0, os.path.join(SOURCE, "examples", "analysis"))
 import depth_decisions as dd  # noqa: E402
 import failure_reasons as fr  # noqa: E402
 from qte_stream import Record, scene_objects  # noqa: E402  (depth_decisions put lib/python on the path)

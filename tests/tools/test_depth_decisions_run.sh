@@ -46,7 +46,7 @@ EOF
   cat "$tmp/obs.rec"; stream-pack action $(action lookalike lookalike) || exit 1
   cat "$tmp/obs.rec"; stream-pack action $(action away target) || exit 1  # overruled, to nowhere
 } > "$tmp/known.rec" || fail "building the known actions"
-$py "$src/examples/depth_decisions.py" --label known "$tmp/known.rec" > "$tmp/known.csv" || fail "depth_decisions.py exit $?"
+$py "$src/examples/analysis/depth_decisions.py" --label known "$tmp/known.rec" > "$tmp/known.csv" || fail "depth_decisions.py exit $?"
 expected='label,k,row,actions,target,lookalike,elsewhere,target_share,lookalike_share,elsewhere_share
 known,10,depth0,3,1,1,1,0.333,0.333,0.333
 known,10,depth1,3,1,1,1,0.333,0.333,0.333
@@ -149,6 +149,6 @@ grep -q "failed for .*qte-k3-t3-seed6" <<<"$err" || fail "the failed run is not 
 [ "$(ls "$tmp/depths")" = reach_prism_qte-k3-t3-seed4.csv ] || fail "a failed run left $(ls "$tmp/depths")"
 
 # --- a stream without objects is refused, naming the option -----------------------------------
-err=$($py "$src/examples/depth_decisions.py" "$src/tests/data/pick_and_lift_obs.rec" 2>&1); rc=$?
+err=$($py "$src/examples/analysis/depth_decisions.py" "$src/tests/data/pick_and_lift_obs.rec" 2>&1); rc=$?
 [ $rc != 0 ] && grep -q "sim-step --objects" <<<"$err" || fail "a stream without objects: exit $rc: $err"
 echo "depth decisions ok"

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The robot's-side drivers (examples/xarm_driver.py, examples/realsense_recorder.py) speak the
+"""The robot's-side drivers (examples/robot/xarm_driver.py, examples/robot/realsense_recorder.py) speak the
 spool protocol (formats/robot-spool.md), run with --dry-run as subprocesses on a temporary spool
 that this test writes as robot-step would (each request under a '.' name, then renamed):
 
@@ -47,11 +47,11 @@ import numpy as np
 
 SOURCE = os.environ.get("QTE_SOURCE") or os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 TOOLS = os.environ.get("QTE_TOOLS") or os.path.join(SOURCE, "build", "tools")
-EXAMPLES = os.path.join(SOURCE, "examples")
+ROBOT = os.path.join(SOURCE, "examples", "robot")
 PYTHON = sys.executable
 tmp = tempfile.mkdtemp(prefix="qte_drivers_")
 sys.dont_write_bytecode = True  # nothing left in the source tree
-sys.path.insert(0, EXAMPLES)
+sys.path.insert(0, ROBOT)
 sys.path.insert(0, os.path.join(SOURCE, "lib", "python"))
 import qte_stream  # noqa: E402
 import realsense_recorder  # noqa: E402  (imports no pyrealsense2 until a camera is opened)
@@ -171,7 +171,7 @@ class Driver:
     """A driver program as a subprocess, its stdout lines collected as they come."""
 
     def __init__(self, script, *args):
-        self.process = subprocess.Popen([PYTHON, LAUNCHER, os.path.join(EXAMPLES, script), *map(str, args)],
+        self.process = subprocess.Popen([PYTHON, LAUNCHER, os.path.join(ROBOT, script), *map(str, args)],
                                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         self.lines = []
         self.reader = threading.Thread(target=self._read, daemon=True)
@@ -525,7 +525,7 @@ class FakeArm:
         self.spool, self.log = p(f"{label}_spool"), p(f"{label}_arm.log")
         os.makedirs(self.spool, exist_ok=True)
         self.process = subprocess.Popen(
-            [PYTHON, os.path.join(EXAMPLES, "xarm_driver.py"), "--spool", self.spool, "--ip", "fake", *map(str, options)],
+            [PYTHON, os.path.join(ROBOT, "xarm_driver.py"), "--spool", self.spool, "--ip", "fake", *map(str, options)],
             env=dict(os.environ, PYTHONPATH=fake_sdk, FAKE_ARM_LOG=self.log, **environment),
             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""examples/failure_reasons.py sorts episodes by where the agent went: checked on a scene built
+"""examples/analysis/failure_reasons.py sorts episodes by where the agent went: checked on a scene built
 here by hand (three objects of points on the table, the expert over the first) against the rule
 it documents: success; a distractor (the object it went for is not the expert's); the target
 missed; elsewhere (over 4 cm from every object); the first closing pose decides a grasp; and a
@@ -13,7 +13,7 @@ import sys
 import numpy as np
 
 SOURCE = os.environ.get("QTE_SOURCE") or os.path.join(os.path.dirname(__file__), "..", "..")
-sys.path.insert(0, os.path.join(SOURCE, "examples"))
+sys.path.insert(0, os.path.join(SOURCE, "examples", "analysis"))
 import failure_reasons as fr  # noqa: E402
 from qte_stream import Record  # noqa: E402  (failure_reasons put lib/python on the path)
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# examples/failure_reasons.py's reasons on a real scene whose answers are known: the first
+# examples/analysis/failure_reasons.py's reasons on a real scene whose answers are known: the first
 # pick_up_cup evaluation scene (sim-step --objects), played by hand-written actions planned by
 # plan-path, or by hand-written trajectories: the cup lifted (success), the gripper closed on
 # empty space (grasp_missed), the cup let go of (dropped), the other cup grasped
@@ -85,7 +85,7 @@ reasons=(success grasp_missed dropped wrong_object goal_in_collision trajectory_
 demo-record "${scene[@]}" --objects --no-points --output "$tmp/expert.rec" 2>/dev/null || fail "demo-record"
 for name in "${reasons[@]}"; do cat "$tmp/$name.rec"; done > "$tmp/agent.rec"
 for name in "${reasons[@]}"; do cat "$tmp/expert.rec"; done > "$tmp/experts.rec"
-$py "$src/examples/failure_reasons.py" --episodes --label known "$tmp/experts.rec" "$tmp/agent.rec" \
+$py "$src/examples/analysis/failure_reasons.py" --episodes --label known "$tmp/experts.rec" "$tmp/agent.rec" \
   > "$tmp/known.csv" 2> "$tmp/known.err" || fail "failure_reasons.py exit $?: $(cat "$tmp/known.err")"
 got=$(sed 's/^episode [0-9]*: \([a-z_]*\) .*/\1/' "$tmp/known.err" | tr '\n' ' ')
 [ "$got" = "${reasons[*]} " ] || fail "reasons: expected ${reasons[*]}, got $got ($(cat "$tmp/known.err"))"
@@ -95,8 +95,8 @@ expected='label,seed,episodes,success,distractor,target,elsewhere,failed_actions
 known,,8,1,1,1,5,3,1,0,1,1,1,0,0,0,0,0,0,1,1,0,1'
 [ "$(cat "$tmp/known.csv")" = "$expected" ] || fail "the counts: $(cat "$tmp/known.csv")"
 # The expert's stream alone: its own episode, sorted by its objects.
-$py "$src/examples/failure_reasons.py" --label expert "$tmp/expert.rec" | tail -1 | grep -q "^expert,,1,1,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0$" \
-  || fail "the expert alone: $($py "$src/examples/failure_reasons.py" "$tmp/expert.rec" 2>&1)"
+$py "$src/examples/analysis/failure_reasons.py" --label expert "$tmp/expert.rec" | tail -1 | grep -q "^expert,,1,1,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0$" \
+  || fail "the expert alone: $($py "$src/examples/analysis/failure_reasons.py" "$tmp/expert.rec" 2>&1)"
 
 # --- the expert's episodes recorded once per key --------------------------------------------
 keyframe "$src/tests/data/reach_target_demo.rec" > "$tmp/transitions.rec" 2>/dev/null || fail "keyframe"

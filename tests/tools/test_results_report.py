@@ -1,12 +1,12 @@
 #!/usr/bin/env python3
-"""docs/results.md is what examples/results_report.py makes of the committed CSVs (so no number
+"""docs/results.md is what examples/analysis/results_report.py makes of the committed CSVs (so no number
 in it is typed by hand, and a CSV committed without `make -C examples paper-report` fails
 here), and the CSVs the report writes itself are up to date. Read as a reader would: the
 summary's numbers are those of the paired CSVs it links and its verdicts follow from them; no
 table is wider than 8 columns; every table of where the agents went has a row for each method of
 the section's final table, with the same number of runs or the replayed ones out of them; every
 link into the repository leads to a file; no sentence speaks of the machine or session that
-made the runs. And examples/seed_plot.py draws seeds as categories: each method's mean and 95%
+made the runs. And examples/analysis/seed_plot.py draws seeds as categories: each method's mean and 95%
 interval as computed here, the same picture twice for the same CSV."""
 import csv
 import math
@@ -19,7 +19,8 @@ import tempfile
 
 SOURCE = os.environ.get("QTE_SOURCE") or os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
 EXAMPLES = os.path.join(SOURCE, "examples")
-sys.path.insert(0, EXAMPLES)
+ANALYSIS = os.path.join(EXAMPLES, "analysis")
+sys.path.insert(0, ANALYSIS)
 import results_report  # noqa: E402
 import seed_plot  # noqa: E402
 
@@ -128,7 +129,7 @@ def check_links_and_words(document):
 
 
 def main():
-    made = subprocess.run([sys.executable, os.path.join(EXAMPLES, "results_report.py"), "--no-write",
+    made = subprocess.run([sys.executable, os.path.join(ANALYSIS, "results_report.py"), "--no-write",
                            os.path.join(EXAMPLES, "results")], capture_output=True, text=True, check=True).stdout
     with open(os.path.join(SOURCE, "docs", "results.md")) as f:
         committed = f.read()
@@ -184,7 +185,7 @@ def main():
         pictures = []
         for k in range(2):
             out = os.path.join(d, f"seeds{k}.png")
-            subprocess.run([sys.executable, os.path.join(EXAMPLES, "seed_plot.py"), "--title", "t", "--output", out, finals],
+            subprocess.run([sys.executable, os.path.join(ANALYSIS, "seed_plot.py"), "--title", "t", "--output", out, finals],
                            check=True)
             with open(out, "rb") as f:
                 pictures.append(f.read())

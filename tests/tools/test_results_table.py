@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""examples/results_table.py, the tables of `make -C examples paper-report`: runs of two tasks
+"""examples/analysis/results_table.py, the tables of `make -C examples paper-report`: runs of two tasks
 with the same method labels stay apart (the task from examples/Makefile's file names), each
 run counts by its last evaluation, and the means, standard deviations, Wilson intervals,
 per-seed finals, learning curves and the K ablation are those of the rows written here."""
@@ -12,7 +12,7 @@ import sys
 import tempfile
 
 SOURCE = os.environ.get("QTE_SOURCE") or os.path.join(os.path.dirname(__file__), "..", "..")
-SCRIPT = os.path.join(SOURCE, "examples", "results_table.py")
+SCRIPT = os.path.join(SOURCE, "examples", "analysis", "results_table.py")
 COLUMNS = ["label", "seed", "env_steps", "train_step", "eval_point", "train_s", "cpu_s", "episodes", "successes",
            "success_rate", "ci95_low", "ci95_high", "mean_steps", "mean_return"]
 

@@ -133,7 +133,7 @@ if not (gripper[:-1] == 850).all() or gripper[-1] != 0 or not np.array_equal(row
     failures.append(f"gripper column {gripper[:3]} ... {gripper[-2:]}: expected open during the move, closed after")
 
 # The player reads the file (its dry run needs no robot and no SDK).
-r = subprocess.run([sys.executable, os.path.join(SOURCE, "examples", "xarm_play.py"), "--dry-run", path],
+r = subprocess.run([sys.executable, os.path.join(SOURCE, "examples", "robot", "xarm_play.py"), "--dry-run", path],
                    capture_output=True, text=True)
 if r.returncode != 0 or f"{len(rows)} rows" not in r.stdout or "850 -> 0" not in r.stdout:
     failures.append(f"xarm_play.py --dry-run: exit {r.returncode}, {r.stdout!r} {r.stderr!r}")

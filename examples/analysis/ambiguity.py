@@ -24,11 +24,12 @@ bounding box grown by a margin on every side and reaching `ABOVE_M` (10 cm) high
 above an object, from which it is grasped or reached, count as on it. Among several, targets
 and distractors come before other objects (zones, bins, boards), then the nearest in plan view
 to the box's centre. Run with Debian's python3."""
+import os
 import sys
 
 import numpy as np
 
-sys.path.insert(0, __file__.rsplit("/", 2)[0] + "/lib/python")  # or installed: make install
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "lib", "python"))  # or installed: make install
 from qte_stream import read_records, scene_objects  # noqa: E402
 
 TABLE_Z, REGION = 0.752, ((-0.05, 0.35), (-0.3, 0.3))

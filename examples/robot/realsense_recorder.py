@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 """The RealSense camera's recorder for the robot spool (formats/robot-spool.md): takes robot-step's frames.
 
-    python3 examples/realsense_recorder.py --spool spool                 # the first camera found
-    python3 examples/realsense_recorder.py --print-intrinsics            # robot-step's --intrinsics
-    python3 examples/realsense_recorder.py --spool spool --dry-run --frames saved/   # no camera
+    python3 examples/robot/realsense_recorder.py --spool spool                 # the first camera found
+    python3 examples/robot/realsense_recorder.py --print-intrinsics            # robot-step's --intrinsics
+    python3 examples/robot/realsense_recorder.py --spool spool --dry-run --frames saved/   # no camera
 
 Watches the spool for capture-<session>-<n>.request and answers each, in the order robot-step
 wrote them, with capture-...-n.color.png (8-bit RGB), capture-...-n.depth.png (16-bit greyscale,

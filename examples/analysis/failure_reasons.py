@@ -61,12 +61,13 @@ nearest object, the failure, and the expert's reason on that scene where its str
 objects. Run with Debian's python3."""
 import argparse
 import csv
+import os
 import sys
 from collections import Counter
 
 import numpy as np
 
-sys.path.insert(0, __file__.rsplit("/", 2)[0] + "/lib/python")  # or installed: make install
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "lib", "python"))  # or installed: make install
 from qte_stream import read_records, scene_objects  # noqa: E402
 from ambiguity import box_centre, object_at, objects, task_objects  # noqa: E402  (one rule for what an object is)
 

@@ -1,12 +1,12 @@
 #!/usr/bin/env python3
 """The xArm 7's driver for the robot spool (formats/robot-spool.md): executes robot-step's motions.
 
-    python3 examples/xarm_driver.py --spool spool --ip 192.168.1.185
-    python3 examples/xarm_driver.py --spool spool --dry-run        # no SDK, no robot
+    python3 examples/robot/xarm_driver.py --spool spool --ip 192.168.1.185
+    python3 examples/robot/xarm_driver.py --spool spool --dry-run        # no SDK, no robot
 
 Watches the spool for motion-<session>-<n>.xarm.csv and executes each in the order robot-step
 wrote them, with UFACTORY's Python SDK (pip install xarm-python-sdk; not a dependency of the
-toolkit). Each file is checked again before anything moves (examples/xarm_play.py's read_moves:
+toolkit). Each file is checked again before anything moves (examples/robot/xarm_play.py's read_moves:
 header, finite numbers, times from 0 and increasing, joint limits and speeds); its first row is
 reached slowly, then the rows are streamed at their times (xarm_play.py's play). A motion of
 several rows must start where the arm is, within --start-tolerance degrees (robot-step plans it

@@ -39,7 +39,7 @@ import sys
 
 import numpy as np
 
-sys.path.insert(0, __file__.rsplit("/", 2)[0] + "/lib/python")  # or installed: make install
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "lib", "python"))  # or installed: make install
 from qte_stream import read_records  # noqa: E402
 from ambiguity import object_at, task_objects  # noqa: E402  (one rule for where an action went)
 from failure_reasons import held_role  # noqa: E402  (one rule for what the gripper holds)

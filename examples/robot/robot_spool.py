@@ -3,7 +3,7 @@ kind in the order they were written, answering each once and atomically, and hon
 and writing `stop` itself, saying why, when the driver ends for any other reason (SIGINT,
 SIGTERM, an error), so that robot-step stops at once instead of waiting for an answer that will
 not come, and nothing is carried out until a person has looked and removed it.
-Imported by examples/xarm_driver.py and examples/realsense_recorder.py; the standard library only.
+Imported by examples/robot/xarm_driver.py and examples/robot/realsense_recorder.py; the standard library only.
 """
 import os
 import re

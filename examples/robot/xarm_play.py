@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Plays xarm-export files on a real xArm 7 with UFACTORY's Python SDK.
 
-    python3 examples/xarm_play.py --ip 192.168.1.185 moves/000004.xarm.csv [more.csv ...]
-    python3 examples/xarm_play.py --dry-run moves/*.xarm.csv     # check the files, move nothing
+    python3 examples/robot/xarm_play.py --ip 192.168.1.185 moves/000004.xarm.csv [more.csv ...]
+    python3 examples/robot/xarm_play.py --dry-run moves/*.xarm.csv     # check the files, move nothing
 
 The SDK is not a dependency of the toolkit; install it where the robot is reached from:
     pip install xarm-python-sdk        (https://github.com/xArm-Developer/xArm-Python-SDK)
@@ -21,7 +21,7 @@ once during them as between streamed rows: Ctrl-C (or SIGTERM) stops the arm wit
 emergency_stop, holds the gripper where it is, and ends the program (status 130). Keep a hand on
 the emergency stop all the same: the planner saw only what the camera saw.
 
-This file is the one home for reading and playing the files: examples/xarm_driver.py imports
+This file is the one home for reading and playing the files: examples/robot/xarm_driver.py imports
 read_moves and play from it.
 """
 import argparse
