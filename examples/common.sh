@@ -56,17 +56,10 @@ finished_run_settings() {  # RUN
 }
 
 # The learner's numbered checkpoints, DIR/step-NNNNNNNN.rec (qattn-train --checkpoint-dir DIR;
-# the program names them in CheckpointDirectory::path_for, lib/learner/training_files.cpp).
+# the program names them in CheckpointDirectory::path_for, lib/learner/training_files.cpp;
+# supervise.py finds the newest).
 checkpoint_path() {  # DIR STEP
   printf '%s/step-%08d.rec\n' "$1" "$2"
-}
-newest_checkpoint_step() {  # DIR -> the step of its newest checkpoint, -1 for none
-  local f n best=-1  # shell builtins only: the learning loop asks twice a second
-  for f in "$1"/step-[0-9]*.rec; do
-    n=${f##*/step-} n=${n%.rec}
-    [[ $n =~ ^[0-9]+$ ]] && (( 10#$n > best )) && best=$(( 10#$n ))
-  done
-  echo "$best"
 }
 
 # The agent acting in its world, a pipeline closed by a FIFO:
