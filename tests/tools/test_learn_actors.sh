@@ -12,14 +12,13 @@ export SEED=0 DEMOS=2 IMAGE=48x48 ACT_K=1 TARGET_K=0 ENV_STEPS=30 CHUNK_EPISODES
 bash "$learn" reach_target "$run" 2> "$tmp/learn.log" &
 learn_pid=$!
 # Actor 1 runs chunks 1, 3, ...: kill its simulator once chunk 1 has started, and meanwhile
-# check that the run never has more than one learner (LeakSanitizer's tracer, a child of the
-# learner with its command line, shows up under make sanitize: not counted).
+# check that the run never has more than one learner: the supervisor's children that are
+# qattn-train (LeakSanitizer's tracer, a child of the learner with its command line, shows up
+# under make sanitize: not counted).
 learners_now() {
-  local p n=0
-  for p in $(pgrep -f "qattn-train --follow .*$run/replay.rec"); do
-    [[ $(ps -o args= -p "$(ps -o ppid= -p "$p" | tr -d ' ')" 2>/dev/null) == *qattn-train* ]] || n=$(( n + 1 ))
-  done
-  echo $n
+  local supervisor
+  supervisor=$(pgrep -P $learn_pid -f supervise.py) || { echo 0; return; }
+  pgrep -c -P "$supervisor" -f "qattn-train --follow .*$run/replay.rec" || true
 }
 killed=0 learners=0
 for _ in $(seq 1 2400); do

@@ -22,21 +22,18 @@ TEST(LearnerSettings, OneRangePerSettingForTheCommandLineAndForCheckpoints) {
       EXPECT_NE(std::string(e.what()).find(setting + " must be "), std::string::npos) << e.what();
     }
   };
-  learner::LearnerConfig c;
-  c.gamma = 1.5;
-  refused(c, "gamma");
-  c = {};
-  c.batch = 0;
-  refused(c, "batch");
-  c = {};
-  c.n_step = 11;
-  refused(c, "n-step");
-  c = {};
-  c.learning_rate = 0;
-  refused(c, "lr");
-  c = {};
-  c.hierarchy.depths = 9;
-  refused(c, "depths");
+  const std::pair<std::string, void (*)(learner::LearnerConfig&)> out_of_range[] = {
+      {"gamma", [](learner::LearnerConfig& c) { c.gamma = 1.5; }},
+      {"batch", [](learner::LearnerConfig& c) { c.batch = 0; }},
+      {"n-step", [](learner::LearnerConfig& c) { c.n_step = 11; }},
+      {"lr", [](learner::LearnerConfig& c) { c.learning_rate = 0; }},
+      {"depths", [](learner::LearnerConfig& c) { c.hierarchy.depths = 9; }},
+  };
+  for (const auto& [setting, spoil] : out_of_range) {
+    learner::LearnerConfig c;
+    spoil(c);
+    refused(c, setting);
+  }
 
   cli::Usage u;
   u.name = "t";
