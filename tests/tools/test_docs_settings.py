@@ -29,7 +29,7 @@ def help_defaults():
             options[name] += " " + line.strip()
         elif not line.strip():
             name = None
-    return {o: (re.search(r"\(default: ([^)]*)\)", d).group(1) if "(default:" in d else None)
+    return {o: (re.search(r"[(;] ?default: ([^)]*)\)", d).group(1) if "default: " in d else None)
             for o, d in options.items()}
 
 
@@ -42,7 +42,7 @@ def man_defaults():
         m = re.match(r"^\.B (\\-\\-[a-z0-9\\-]+)", line)
         if m and i + 1 < len(lines):
             name = m.group(1).replace("\\-", "-")
-            d = re.search(r"\(default: ([^)]*)\)", lines[i + 1])
+            d = re.search(r"[(;] ?default: ([^)]*)\)", lines[i + 1])
             options[name] = d.group(1).replace("\\-", "-") if d else None
     return options
 
