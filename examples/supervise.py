@@ -128,15 +128,20 @@ def checkpoint_path(directory, step):
     return os.path.join(directory, f"step-{step:08d}.rec")
 
 
-def last_line(path):
-    """The last line of a text file (its last 4 KiB), '' when there is none."""
+def tail_lines(path):
+    """The lines of a text file's last 8 KiB, [] when there are none (a log's end, for messages)."""
     try:
         with open(path, "rb") as f:
             f.seek(0, os.SEEK_END)
-            f.seek(max(0, f.tell() - 4096))
-            lines = f.read().decode("utf-8", "replace").splitlines()
+            f.seek(max(0, f.tell() - 8192))
+            return f.read().decode("utf-8", "replace").splitlines()
     except OSError:
-        return ""
+        return []
+
+
+def last_line(path):
+    """The last line of a text file, '' when there is none."""
+    lines = tail_lines(path)
     return lines[-1] if lines else ""
 
 
@@ -417,7 +422,7 @@ class Supervisor:
                 if self.chunk_done(c):
                     continue
                 self.failures[c] = self.failures.get(c, 0) + 1
-                log_line = [line for line in _tail_lines(os.path.join(self.run, "actor.log"))
+                log_line = [line for line in tail_lines(os.path.join(self.run, "actor.log"))
                             if not re.match(r" *[0-9]* Done ", line)]  # bash's notes of jobs ended
                 self.log(f"{self.who}: actor {i} failed in chunk {c} (attempt {self.failures[c]}): "
                          f"{self.actor_failure(i)}; last line of {self.run}/actor.log: {log_line[-1] if log_line else ''}")
@@ -547,16 +552,6 @@ class Supervisor:
                 pass
         self.reap(self.learner, block=True)
         self.learner = None
-
-
-def _tail_lines(path):
-    try:
-        with open(path, "rb") as f:
-            f.seek(0, os.SEEK_END)
-            f.seek(max(0, f.tell() - 8192))
-            return f.read().decode("utf-8", "replace").splitlines()
-    except OSError:
-        return []
 
 
 def parse(argv):

@@ -4,14 +4,6 @@
 
 namespace qte::camera_recordings {
 
-namespace {
-
-void add_pose_fields(stream::Record& obs, const CameraSetup& camera) {
-  observation::set_camera_pose(obs, camera.name, camera.intrinsics, camera.camera_to_world);
-}
-
-}  // namespace
-
 void add_camera_images(stream::Record& obs, const CameraSetup& camera, const cv::Mat& bgr, const cv::Mat& depth,
                        const std::string& what) {
   if (bgr.type() != CV_8UC3) throw Error(what + ": expected an 8-bit colour image");
@@ -39,7 +31,7 @@ void add_camera_images(stream::Record& obs, const CameraSetup& camera, const cv:
     for (std::size_t i = 0; i < counts.size(); ++i) metres[i] = static_cast<float>(counts[i] * camera.depth_unit_m);
     obs.set<float>(camera.name + ".depth", {h, w}, metres);
   }
-  add_pose_fields(obs, camera);
+  observation::set_camera_pose(obs, camera.name, camera.intrinsics, camera.camera_to_world);
   if (camera.store_points) {
     // The points every reader would rebuild from the depth, once (plan-path needs them stored).
     for (const voxels::CameraCloud& c : voxels::camera_clouds(obs))
@@ -56,7 +48,7 @@ void add_camera_cloud(stream::Record& obs, const CameraSetup& camera, const voxe
   }
   obs.set<uint8_t>(camera.name + ".rgb", {cloud.height, cloud.width, 3}, cloud.cloud.rgb);
   obs.set<float>(camera.name + ".points", {cloud.height, cloud.width, 3}, world);
-  add_pose_fields(obs, camera);
+  observation::set_camera_pose(obs, camera.name, camera.intrinsics, camera.camera_to_world);
 }
 
 observation::ArmState arm_state(const RobotState& state, const robot::RobotModel& robot,

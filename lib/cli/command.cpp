@@ -196,13 +196,17 @@ double Arguments::parse_real(const std::string& name) const {
   throw UsageError("--" + name + ": expected a number, got '" + v + "'");
 }
 
+// "0..1", "1e-12..1e+30": a real range as --help and the errors write it.
+static std::string real_range_text(double lo, double hi) {
+  std::ostringstream range;
+  range << lo << ".." << hi;
+  return range.str();
+}
+
 double Arguments::real(const std::string& name, double lo, double hi) const {
   const double x = parse_real(name);
-  if (!std::isfinite(x) || x < lo || x > hi) {
-    std::ostringstream range;
-    range << lo << ".." << hi;
-    throw UsageError("--" + name + " must be " + range.str() + ", got " + text(name));
-  }
+  if (!std::isfinite(x) || x < lo || x > hi)
+    throw UsageError("--" + name + " must be " + real_range_text(lo, hi) + ", got " + text(name));
   return x;
 }
 
@@ -243,9 +247,7 @@ OptionSpec real_option(std::string name, std::string value_name, std::string hel
 std::string range_text(const OptionSpec& o) {
   if (o.number == OptionSpec::Number::integer)
     return std::to_string(static_cast<int64_t>(o.low)) + ".." + std::to_string(static_cast<int64_t>(o.high));
-  std::ostringstream range;
-  range << o.low << ".." << o.high;
-  return range.str();
+  return real_range_text(o.low, o.high);
 }
 
 void check_range(const std::vector<OptionSpec>& options, const std::string& name, double value,

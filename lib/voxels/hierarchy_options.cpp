@@ -26,24 +26,17 @@ auto as_usage_error(Parse parse) {
 
 }  // namespace
 
-// "X,Y,Z,S" as --bounds takes it.
-std::string bounds_text(const GridBounds& bounds) {
+// "-0.3,-0.5,0.6,1" (--bounds) or "0.15,0.05" (--offset): a default as those options take it.
+std::string comma_separated(const std::vector<double>& values) {
   std::string text;
-  for (double v : bounds_values(bounds)) text += (text.empty() ? "" : ",") + cli::default_text(v);
-  return text;
-}
-
-// "0.15" or "0.15,0.05" as --offset takes it.
-std::string offsets_text(const std::vector<double>& offsets_m) {
-  std::string text;
-  for (double v : offsets_m) text += (text.empty() ? "" : ",") + cli::default_text(v);
+  for (double v : values) text += (text.empty() ? "" : ",") + cli::default_text(v);
   return text;
 }
 
 std::vector<cli::OptionSpec> scene_options() {
   const CoarseToFine published;
   return {{"voxels", "V", kVoxelsHelp, cli::default_text(published.voxels())},
-          {"bounds", "X,Y,Z,S", kBoundsHelp, bounds_text(published.scene)}};
+          {"bounds", "X,Y,Z,S", kBoundsHelp, comma_separated(bounds_values(published.scene))}};
 }
 
 GridBounds parse_scene(const cli::Arguments& args, int min_voxels, int max_voxels) {
@@ -56,7 +49,7 @@ std::vector<cli::OptionSpec> hierarchy_options() {
   const CoarseToFine published;
   options.insert(options.begin() + 1,
                  {cli::integer_option("depths", "D", kDepthsHelp, cli::default_text(published.depths), 1, kMaxDepths),
-                  {"offset", "M[,M...]", kOffsetHelp, offsets_text(published.offsets_m)}});
+                  {"offset", "M[,M...]", kOffsetHelp, comma_separated(published.offsets_m)}});
   return options;
 }
 
