@@ -6,6 +6,7 @@
 #include "planning/planner_options.hpp"
 #include "robot/robot_model.hpp"
 #include "sim_step/simulator_options.hpp"
+#include "stream/field_names.hpp"
 #include "stream/writer.hpp"
 #include "tasks/task.hpp"
 
@@ -27,7 +28,7 @@ static cli::Usage usage() {
   };
   u.options = {
       {"task", "T", "one of: " + tasks::task_list(), "", false, true},
-      {"retries", "N", "new seeds to try for an episode whose expert failed", "0"},
+      cli::integer_option("retries", "N", "new seeds to try for an episode whose expert failed", "0", 0, 1000),
   };
   u.options.push_back(planning::time_budget_option());
   u.options.push_back(cli::output_file());
@@ -48,7 +49,7 @@ static cli::Usage usage() {
 static void run(const cli::Arguments& args) {
   demos::DemoOptions options;
   options.episodes = sim_step::parse_episode_plan(args, args.text("task"));
-  options.retries = static_cast<int>(args.integer("retries", 0, 1000));
+  options.retries = static_cast<int>(args.integer("retries"));
   options.planner = planning::planner_options_from(args);
   options.simulator = sim_step::parse_camera_options(args);
   options.simulator.point_clouds = true;  // the planner needs them; dropped on output with --no-points
@@ -61,7 +62,7 @@ static void run(const cli::Arguments& args) {
       [&](const stream::Record& r) {
         if (!drop_points || r.type() != "obs") return writer.write(r);
         stream::Record slim = r;
-        for (const auto& camera : options.simulator.cameras) slim.remove(camera.name + ".points");
+        for (const auto& camera : options.simulator.cameras) slim.remove(camera.name + fields::per_camera::points);
         writer.write(slim);
       },
       [](const std::string& line) { std::cerr << "demo-record: " << line << "\n"; });

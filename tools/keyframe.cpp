@@ -43,8 +43,8 @@ static cli::Usage usage() {
   };
   u.arguments = {cli::input_file("demonstrations")};
   u.options = {
-      {"augment-every", "N", "start a demo-augmentation chain at every N-th frame; 0 for none",
-       cli::default_text(keyframes::TransitionOptions{}.augmentation_every_n)},
+      cli::integer_option("augment-every", "N", "start a demo-augmentation chain at every N-th frame; 0 for none",
+                          cli::default_text(keyframes::TransitionOptions{}.augmentation_every_n), 0, 100000),
       {"no-crop-augmentation", "", "use the unshifted centres for the deeper grids", ""},
       {"keep-failed", "", "also convert unsuccessful episodes (reward 0 throughout)", ""},
       {"not-demo", "", "mark the transitions as the agent's own, not demonstrations", ""},
@@ -66,7 +66,7 @@ static cli::Usage usage() {
 
 static void run(const cli::Arguments& args) {
   keyframes::TransitionOptions options;
-  options.augmentation_every_n = static_cast<int>(args.integer("augment-every", 0, 100000));
+  options.augmentation_every_n = static_cast<int>(args.integer("augment-every"));
   options.hierarchy = voxels::parse_hierarchy(args);
   options.crop_augmentation = !args.flag("no-crop-augmentation");
   options.keep_failed = args.flag("keep-failed");

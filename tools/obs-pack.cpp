@@ -62,14 +62,19 @@ static cli::Usage usage() {
       {"rgb", "PATTERN", "colour PNGs, e.g. frames/color_%06d.png", ""},
       {"depth", "PATTERN", "16-bit depth PNGs matching --rgb, e.g. frames/depth_%06d.png", ""},
       {"pcd", "PATTERN", "instead of --rgb/--depth: point clouds (.pcd, camera frame, with rgb if any)", ""},
-      {"start", "N", "index of the first frame", "0"},
-      {"count", "N", "frames to read (default: until the first missing index; with --frame-times, its rows)", ""},
+      cli::integer_option("start", "N", "index of the first frame", "0", 0, 1000000000),
+      cli::integer_option("count", "N",
+                          "frames to read (default: until the first missing index; with --frame-times, its rows)", "",
+                          1, 1000000000),
       {"joints", "FILE.csv", "robot state per frame: 7 joint angles (rad)[, gripper opening (m)]", ""},
-      {"joint-log", "FILE.csv", "instead of --joints: time (s), 7 joint angles (rad), gripper opening (m)[, open 1/0]", ""},
+      {"joint-log", "FILE.csv", "instead of --joints: time (s), 7 joint angles (rad), gripper opening (m)[, open 1/0]",
+       ""},
       {"frame-times", "FILE.csv", "each frame's time (s) on the joint log's clock, one row per frame", ""},
-      {"success", "0|1", "the recording is one demonstration, successful (1) or not (0); needs --joint-log", ""},
+      cli::integer_option("success", "0|1",
+                          "the recording is one demonstration, successful (1) or not (0); needs --joint-log", "", 0, 1),
       {"task", "NAME", "the records' task name", "real"},
-      {"episode-length", "N", "next-best poses per episode (the networks' time input scales by it)", "10"},
+      cli::integer_option("episode-length", "N", "next-best poses per episode (the networks' time input scales by it)",
+                          "10", 1, 1000),
   };
   u.add_options(camera_recordings::camera_setup_options());
   u.options.push_back(cli::output_file());
@@ -102,9 +107,9 @@ static void run(const cli::Arguments& args) {
   recording.pcd_pattern = args.text("pcd");
   recording.camera = camera_recordings::camera_setup_from(args);
   if (images && !recording.camera.intrinsics) throw UsageError("depth images need --intrinsics");
-  recording.start = args.integer("start", 0, 1000000000);
-  recording.count = args.has("count") ? args.integer("count", 1, 1000000000) : -1;
-  recording.episode_length = static_cast<int>(args.integer("episode-length", 1, 1000));
+  recording.start = args.integer("start");
+  recording.count = args.has("count") ? args.integer("count") : -1;
+  recording.episode_length = static_cast<int>(args.integer("episode-length"));
   recording.task = args.text("task");
   const robot::RobotModel robot = robot::RobotModel::xarm7();
   if (args.has("joints") && args.has("joint-log")) throw UsageError("give --joints or --joint-log, not both");
@@ -118,7 +123,7 @@ static void run(const cli::Arguments& args) {
   if (args.has("joint-log"))
     camera_recordings::add_joint_log(recording, camera_recordings::read_joint_log(args.text("joint-log"), robot),
                                      camera_recordings::read_frame_times(args.text("frame-times")));
-  if (args.has("success")) recording.demonstration_success = args.integer("success", 0, 1) == 1;
+  if (args.has("success")) recording.demonstration_success = args.integer("success") == 1;
 
   std::vector<std::string> inputs;
   for (const char* file : {"joints", "joint-log", "frame-times"})

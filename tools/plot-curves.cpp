@@ -58,7 +58,7 @@ static cli::Usage usage() {
       {"y-range", "LO,HI", "fix the vertical axis to LO..HI", ""},
       {"size", "WxH", "picture size in pixels (of each panel with --panel)", "800x500"},
       {"panel", "COLUMN", "one plot per distinct value of COLUMN (e.g. task), side by side", ""},
-      {"panel-columns", "N", "panels to a row with --panel", "4"},
+      cli::integer_option("panel-columns", "N", "panels to a row with --panel", "4", 1, 100),
   };
   u.examples = {
       {"plot-curves --x step --y success_rate --group label --band ci --y-range 0,1 "
@@ -95,7 +95,7 @@ static void run(const cli::Arguments& args) {
   if (columns.panel.empty())
     report::save_curve_plot(output, curves.curves(), plot);
   else
-    report::save_panel_plot(output, curves.panels(), plot, static_cast<int>(args.integer("panel-columns", 1, 100)));
+    report::save_panel_plot(output, curves.panels(), plot, static_cast<int>(args.integer("panel-columns")));
 }
 
 int main(int argc, char** argv) { return cli::run_tool(argc, argv, usage(), run); }

@@ -74,14 +74,20 @@ static cli::Usage usage() {
   u.options = {
       {"checkpoint-dir", "DIR", "where checkpoints go (required)", ""},
       {"resume", "", "continue from DIR/latest.rec when it exists", ""},
-      {"overwrite", "", "start over in a DIR that holds a run (its checkpoints are replaced); without it or "
-                        "--resume such a DIR is refused", ""},
-      {"steps-allowed", "N", "print the gradient steps --follow allows after N agent transitions (with --pretrain and "
-                             "--replay-ratio) and exit: the pacing rule, for scripts that wait on the learner", ""},
-      {"keep", "N", "numbered checkpoints to keep", "3"},
+      {"overwrite", "",
+       "start over in a DIR that holds a run (its checkpoints are replaced); without it or "
+       "--resume such a DIR is refused",
+       ""},
+      cli::integer_option("steps-allowed", "N",
+                          "print the gradient steps --follow allows after N agent transitions (with --pretrain and "
+                          "--replay-ratio) and exit: the pacing rule, for scripts that wait on the learner",
+                          "", 0, INT64_MAX),
+      cli::integer_option("keep", "N", "numbered checkpoints to keep", "3", 1, 100000),
       nets::precision_option(),
-      {"print-precision", "", "print what the networks run in here with these options (fp32 or bf16, then why "
-                               "fp32 where bf16 was asked for) and exit; the progress lines end with it too", ""},
+      {"print-precision", "",
+       "print what the networks run in here with these options (fp32 or bf16, then why "
+       "fp32 where bf16 was asked for) and exit; the progress lines end with it too",
+       ""},
   };
   u.add_options(learner::loop_options());
   u.add_options(learner::learner_config_options());
@@ -104,7 +110,7 @@ static void run(const cli::Arguments& args) {
   const learner::LearnerConfig config = learner::learner_config_from(args);
   learner::LoopOptions loop = learner::loop_options_from(args);
   if (args.has("steps-allowed")) {
-    std::cout << learner::allowed_steps(loop, args.integer("steps-allowed", 0, INT64_MAX)) << "\n";
+    std::cout << learner::allowed_steps(loop, args.integer("steps-allowed")) << "\n";
     return;
   }
   if (args.flag("print-precision")) {
@@ -129,7 +135,7 @@ static void run(const cli::Arguments& args) {
   learner::QLearner learner(config);
   replay::ReplayBuffer replay(replay_options);
   learner::InputFollower inputs(args.positional(), loop.follow);  // a missing input fails before any directory is made
-  learner::CheckpointDirectory checkpoints(args.text("checkpoint-dir"), static_cast<int>(args.integer("keep", 1, 100000)));
+  learner::CheckpointDirectory checkpoints(args.text("checkpoint-dir"), static_cast<int>(args.integer("keep")));
   learner::TrainingLoop training(learner, replay, inputs, checkpoints, loop, std::cerr);
   training.start(args.flag("resume"));
   training.run();

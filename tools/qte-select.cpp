@@ -76,19 +76,26 @@ static cli::Usage usage() {
   };
   u.arguments = {cli::input_file()};
   u.options = {
-      {"checkpoint", "FILE", "the networks: a 'checkpoint' record as qattn-train writes it (required unless --keyframes)", ""},
+      {"checkpoint", "FILE",
+       "the networks: a 'checkpoint' record as qattn-train writes it (required unless --keyframes)", ""},
       {"keyframes", "FILE", "act with FILE's demonstrated keyframes (keyframe's transitions) instead of networks", ""},
-      {"k", "K", "voxels expanded per non-leaf grid; 1 is C2F-ARM's greedy choice; 'auto': as many as the "
-                 "node's Q volume asks for (--k-margin or --k-mass, at most --k-max)", "10"},
-      {"epsilon", "E", "probability, per depth, of a random voxel instead of the chosen one", "0"},
-      {"index-noise", "SIGMA", "standard deviation of Gaussian noise on the last depth's voxel index, voxels", "0"},
-      {"rotation-noise", "BINS", "standard deviation of Gaussian noise on the rotation bins (5 degrees each)", "0"},
-      {"gripper-flip", "P", "probability of flipping the gripper command", "0"},
+      {"k", "K",
+       "voxels expanded per non-leaf grid; 1 is C2F-ARM's greedy choice; 'auto': as many as the "
+       "node's Q volume asks for (--k-margin or --k-mass, at most --k-max)",
+       "10"},
+      cli::real_option("epsilon", "E", "probability, per depth, of a random voxel instead of the chosen one", "0", 0,
+                       1),
+      cli::real_option("index-noise", "SIGMA",
+                       "standard deviation of Gaussian noise on the last depth's voxel index, voxels", "0", 0, 1e6),
+      cli::real_option("rotation-noise", "BINS",
+                       "standard deviation of Gaussian noise on the rotation bins (5 degrees each)", "0", 0, 1e6),
+      cli::real_option("gripper-flip", "P", "probability of flipping the gripper command", "0", 0, 1),
       {"ignore-collisions", "", "set ignore_collisions in every action (straight-line moves)", ""},
       {"reload", "", "at the start of each episode, load the checkpoint again when the file changed", ""},
       nets::torch_threads_option(2),
       nets::precision_option(),
-      {"png", "DIR", "save the Q-values of every depth's grid as DIR/<n>.depth<d>.png (all at the end of the input, or none)", ""},
+      {"png", "DIR",
+       "save the Q-values of every depth's grid as DIR/<n>.depth<d>.png (all at the end of the input, or none)", ""},
   };
   u.options.push_back(cli::output_file());
   u.add_options(voxels::checkpoint_hierarchy_options());
@@ -119,10 +126,10 @@ namespace {
 
 qattention::Exploration exploration_from(const cli::Arguments& args) {
   qattention::Exploration exploration;
-  exploration.epsilon = args.real("epsilon", 0, 1);
-  exploration.index_noise = args.real("index-noise", 0, 1e6);
-  exploration.rotation_noise = args.real("rotation-noise", 0, 1e6);
-  exploration.gripper_flip = args.real("gripper-flip", 0, 1);
+  exploration.epsilon = args.real("epsilon");
+  exploration.index_noise = args.real("index-noise");
+  exploration.rotation_noise = args.real("rotation-noise");
+  exploration.gripper_flip = args.real("gripper-flip");
   return exploration;
 }
 
@@ -152,7 +159,7 @@ static void run(const cli::Arguments& args) {
   options.seed = args.seed();
   options.prepare = point_clouds::observation_filter(point_clouds::parse_cloud_filters(args));
 
-  nets::set_torch_threads(static_cast<int>(args.integer("threads", 1, 256)));
+  nets::set_torch_threads(static_cast<int>(args.integer("threads")));
   nets::use_precision_option(args);
   qattention::CheckpointNetworks networks(checkpoint);
   options.hierarchy = voxels::checkpoint_hierarchy(args, networks.hierarchy(), networks.config().net.voxels,

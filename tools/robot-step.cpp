@@ -74,29 +74,34 @@ static cli::Usage usage() {
   u.arguments = {cli::input_file()};
   u.options = {
       {"spool", "DIR", "the directory the arm driver and camera recorder answer in", ""},
-      {"task", "T", "run episodes of task T by itself (its episode length; --episodes, --variation, --scenes apply)", ""},
+      {"task", "T", "run episodes of task T by itself (its episode length; --episodes, --variation, --scenes apply)",
+       ""},
       {"judge", "CMD", "outcomes and resets from a command (default: a person at --terminal)", ""},
       {"outcomes", "FILE", "outcomes from a file, one a line: success, failure [reason], continue", ""},
       {"terminal", "TTY", "the terminal a person judges at", "/dev/tty"},
-      {"home", "J1,...,J7", "start pose of every episode, joint angles in degrees (default: the simulation's, "
-                            "0,-20.05,0,42.97,0,63.03,0: the gripper above the table, pointing down)", ""},
+      {"home", "J1,...,J7",
+       "start pose of every episode, joint angles in degrees (default: the simulation's, "
+       "0,-20.05,0,42.97,0,63.03,0: the gripper above the table, pointing down)",
+       ""},
       {"workspace", "X0,Y0,Z0,X1,Y1,Z1",
        "box the whole arm must stay in (world frame, m, within 10 m of the origin; the base excepted)",
        workspace_text(defaults.workspace)},
-      {"reach-tolerance", "DEG", "largest difference between a motion's last row and the joints the driver reports",
-       cli::default_text(defaults.reach_tolerance_deg)},
-      {"speed", "F", "fraction of each joint's speed limit a motion may use (faster ones are slowed)",
-       cli::default_text(defaults.speed_fraction)},
+      cli::real_option("reach-tolerance", "DEG",
+                       "largest difference between a motion's last row and the joints the driver reports",
+                       cli::default_text(defaults.reach_tolerance_deg), 0.01, 30),
+      cli::real_option("speed", "F", "fraction of each joint's speed limit a motion may use (faster ones are slowed)",
+                       cli::default_text(defaults.speed_fraction), 0.01, 1.0),
       cli::real_option("rate", "HZ", "rows per second of the motions handed to the arm (its servo rate)",
                        cli::default_text(defaults.timing.rate_hz), robot::XarmTiming::kMinRate_hz,
                        robot::XarmTiming::kMaxRate_hz),
       cli::real_option("settle", "S", "seconds after a motion's end before its gripper command",
                        cli::default_text(defaults.timing.settle_s), robot::XarmTiming::kMinSettle_s,
                        robot::XarmTiming::kMaxSettle_s),
-      {"episode-length", "N", "steps per episode (default: the task's, 10 without --task)", ""},
+      cli::integer_option("episode-length", "N", "steps per episode (default: the task's, 10 without --task)", "", 1,
+                          1000),
       {"stop-file", "FILE", "stop the robot at once when FILE exists", ""},
-      {"motion-timeout", "S", "longest wait for the arm driver's answer", "120"},
-      {"capture-timeout", "S", "longest wait for the camera recorder's answer", "10"},
+      cli::real_option("motion-timeout", "S", "longest wait for the arm driver's answer", "120", 0.1, 86400),
+      cli::real_option("capture-timeout", "S", "longest wait for the camera recorder's answer", "10", 0.1, 86400),
       {"dry-run", "", "send nothing: print each motion on stderr and take it as reached", ""},
       {"compress", "", "zstd-compress images and point clouds (for files on disk)", ""},
   };
@@ -147,13 +152,13 @@ static void run(const cli::Arguments& args) {
   if (!options.camera.intrinsics) throw UsageError("depth images need --intrinsics");
   if (args.has("home")) options.home = home_from(args);
   options.workspace = workspace_from(args);
-  options.speed_fraction = args.real("speed", 0.01, 1.0);
-  options.reach_tolerance_deg = args.real("reach-tolerance", 0.01, 30);
+  options.speed_fraction = args.real("speed");
+  options.reach_tolerance_deg = args.real("reach-tolerance");
   options.timing.rate_hz = args.real("rate");
   options.timing.settle_s = args.real("settle");
-  options.episode_length = args.has("episode-length") ? static_cast<int>(args.integer("episode-length", 1, 1000))
-                           : plan ? tasks::make_task(plan->task)->episode_length()
-                                  : 10;
+  options.episode_length = args.has("episode-length") ? static_cast<int>(args.integer("episode-length"))
+                           : plan                     ? tasks::make_task(plan->task)->episode_length()
+                                                      : 10;
   options.dry_run = args.flag("dry-run");
   options.compress = args.flag("compress");
   options.log = &std::cerr;
@@ -163,8 +168,8 @@ static void run(const cli::Arguments& args) {
     return !stop_file.empty() && std::filesystem::exists(stop_file) ? "the stop file " + stop_file + " exists" : "";
   };
   robot_step::Spool spool(args.text("spool"), static_cast<long>(::getpid()),
-                          std::chrono::milliseconds(static_cast<int64_t>(args.real("motion-timeout", 0.1, 86400) * 1000)),
-                          std::chrono::milliseconds(static_cast<int64_t>(args.real("capture-timeout", 0.1, 86400) * 1000)),
+                          std::chrono::milliseconds(static_cast<int64_t>(args.real("motion-timeout") * 1000)),
+                          std::chrono::milliseconds(static_cast<int64_t>(args.real("capture-timeout") * 1000)),
                           should_stop);
   // An interrupted robot-step halts the arm: the drivers stop at the spool's `stop`.
   write_on_fatal_signal(spool.directory() + "/stop", "robot-step was interrupted\n");

@@ -39,11 +39,15 @@ static cli::Usage usage() {
   u.arguments = {cli::input_file()};
   u.options = {
       {"task", "T", "run episodes of task T by itself (--episodes, --variation and --scenes apply to them)", ""},
-      {"every-step", "", "also write an observation at every 50 ms control step of a trajectory "
-                         "(full demonstrations)", ""},
-      {"threads", "N", "rendering threads", "2"},
-      {"list-tasks", "", "print the tasks, one a line: name, variations, episode length and what variation 0 asks "
-                         "(tab-separated), and exit", ""},
+      {"every-step", "",
+       "also write an observation at every 50 ms control step of a trajectory "
+       "(full demonstrations)",
+       ""},
+      cli::integer_option("threads", "N", "rendering threads", "2", 1, 256),
+      {"list-tasks", "",
+       "print the tasks, one a line: name, variations, episode length and what variation 0 asks "
+       "(tab-separated), and exit",
+       ""},
   };
   u.options.push_back(cli::output_file());
   u.add_options(sim_step::chunk_options());
@@ -76,7 +80,7 @@ static void run(const cli::Arguments& args) {
   }
   sim_step::SimulatorOptions options = sim_step::parse_camera_options(args);
   options.observe_every_step = args.flag("every-step");
-  options.render_threads = static_cast<int>(args.integer("threads", 1, 256));
+  options.render_threads = static_cast<int>(args.integer("threads"));
 
   const robot::RobotModel robot = robot::RobotModel::xarm7();
   sim_step::Simulator simulator(robot, options);

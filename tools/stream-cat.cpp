@@ -27,8 +27,10 @@ static cli::Usage usage() {
   u.options = {
       {"type", "T", "keep only records of type T", "", true},
       {"exclude", "T", "drop records of type T", "", true},
-      {"where", "NAME=VALUE", "keep only records whose scalar or text field NAME equals VALUE (numbers compare as numbers)", "", true},
-      {"head", "N", "stop after N records have been written; -1 for no limit", "-1"},
+      {"where", "NAME=VALUE",
+       "keep only records whose scalar or text field NAME equals VALUE (numbers compare as numbers)", "", true},
+      cli::integer_option("head", "N", "stop after N records have been written; -1 for no limit", "-1", -1,
+                          1000000000000000),
       cli::max_record_bytes_option(),
   };
   u.add_options(cli::append_options());
@@ -47,10 +49,8 @@ static cli::Usage usage() {
 static void run(const cli::Arguments& args) {
   const std::vector<std::string> files = args.inputs();
   const auto keep = args.all("type"), drop = args.all("exclude");
-  stream::RecordFilter filter({{keep.begin(), keep.end()},
-                               {drop.begin(), drop.end()},
-                               args.assignments("where"),
-                               args.integer("head", -1, 1000000000000000)});
+  stream::RecordFilter filter(
+      {{keep.begin(), keep.end()}, {drop.begin(), drop.end()}, args.assignments("where"), args.integer("head")});
   const stream::ReadOptions read_options = cli::read_options_from(args);
   const stream::WriteOptions write_options = cli::write_options_from(args, files);
   std::size_t next_file = 0;

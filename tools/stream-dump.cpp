@@ -55,16 +55,21 @@ static cli::Usage usage() {
   u.options = {
       {"json", "", "print JSON Lines instead of text", ""},
       {"type", "T", "show only records of type T", "", true},
-      {"values", "N", "values shown per field; -1 shows all", "6"},
+      cli::integer_option("values", "N", "values shown per field; -1 shows all", "6", -1, 1000000000),
       {"all-values", "", "show every value (same as --values -1)", ""},
-      {"npy", "DIR", "also export the fields of the shown records into DIR: one stacked .npy array per record type and field", ""},
+      {"npy", "DIR",
+       "also export the fields of the shown records into DIR: one stacked .npy array per record type and field", ""},
       {"per-record", "", "with --npy, write one .npy file per record and field instead of stacked arrays", ""},
       {"pcd", "DIR", "also export every camera's point cloud of the shown observations as .pcd files into DIR", ""},
       {"summary", "", "print only a count of records and bytes per type at the end", ""},
-      {"schema", "", "print the record types and their fields (name, dtype, shape, optional, meaning) "
-                     "instead of reading streams", ""},
-      {"text", "", "with --npy or --pcd, print the records as well (without it those write files only; --json "
-                   "prints them as JSON Lines)", ""},
+      {"schema", "",
+       "print the record types and their fields (name, dtype, shape, optional, meaning) "
+       "instead of reading streams",
+       ""},
+      {"text", "",
+       "with --npy or --pcd, print the records as well (without it those write files only; --json "
+       "prints them as JSON Lines)",
+       ""},
       cli::max_record_bytes_option(),
   };
   u.examples = {
@@ -104,7 +109,7 @@ static void run(const cli::Arguments& args) {
     return;
   }
   stream::InspectOptions inspect;
-  inspect.max_values = args.flag("all-values") ? -1 : args.integer("values", -1, 1000000000);
+  inspect.max_values = args.flag("all-values") ? -1 : args.integer("values");
   if (args.flag("per-record") && !args.has("npy")) throw UsageError("--per-record goes with --npy DIR");
   // The exported files appear all or none (one staging directory when both options name one).
   std::unique_ptr<OutputDirectory> npy_out, pcd_out;

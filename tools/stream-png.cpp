@@ -7,9 +7,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include "cli/command.hpp"
-#include "common/indexed_name.hpp"
 #include "common/atomic_file.hpp"
+#include "common/indexed_name.hpp"
 #include "render/camera.hpp"
+#include "stream/field_names.hpp"
 #include "stream/reader.hpp"
 #include "video/episode_video.hpp"
 #include "voxels/observation_cloud.hpp"
@@ -41,12 +42,12 @@ static cli::Usage usage() {
       {"type", "T", "only records of type T", "obs"},
       {"depth", "", "also save depth images", ""},
       {"depth-mm", "", "also save depth as 16-bit PNGs in millimetres", ""},
-      {"every", "N", "only every N-th record of the type", "1"},
+      cli::integer_option("every", "N", "only every N-th record of the type", "1", 1, 1000000000),
       {"video", "FILE", "write the frames as one video, FILE.mp4 or FILE.gif, instead of PNG files", ""},
-      {"fps", "F", "video frames per second", "2"},
+      cli::real_option("fps", "F", "video frames per second", "2", 0.01, 1000),
       {"camera", "NAME", "the camera a video shows", "front"},
       {"attention", "DIR", "show qte-select's pictures from DIR beside each video frame", ""},
-      {"height", "PX", "video frame height; every panel is scaled to it", "256"},
+      cli::integer_option("height", "PX", "video frame height; every panel is scaled to it", "256", 16, 4096),
   };
   u.examples = {
       {"sim-step --task lift_numbered_block --image-size 256x256 < /dev/null | stream-png --dir frames/",
@@ -65,8 +66,9 @@ namespace {
 void save_pngs(const stream::Record& record, const OutputDirectory& dir, bool depth, bool depth_mm) {
   for (const auto& field : record.fields()) {
     const std::string path = dir.path(indexed_name(record.position.record_index, field.name()));
-    if (stream::ends_with(field.name(), ".rgb")) render::save_rgb_png(path + ".png", video::image_field(record, field, false));
-    if (!stream::ends_with(field.name(), ".depth") || !(depth || depth_mm)) continue;
+    if (stream::ends_with(field.name(), fields::per_camera::rgb))
+      render::save_rgb_png(path + ".png", video::image_field(record, field, false));
+    if (!stream::ends_with(field.name(), fields::per_camera::depth) || !(depth || depth_mm)) continue;
     const cv::Mat metres = video::image_field(record, field, true);
     if (depth) render::save_depth_png(path + ".png", metres);
     if (depth_mm) {
@@ -81,16 +83,15 @@ void save_pngs(const stream::Record& record, const OutputDirectory& dir, bool de
 static void run(const cli::Arguments& args) {
   const std::vector<std::string> files = args.inputs();
   const std::string dir = args.text("dir"), type = args.text("type");
-  const int64_t every = args.integer("every", 1, 1000000000);
+  const int64_t every = args.integer("every");
   if (args.has("attention") && !std::filesystem::is_directory(args.text("attention")))
     throw UsageError("--attention " + args.text("attention") + ": no such directory (qte-select --png DIR writes the pictures)");
   std::unique_ptr<video::EpisodeVideo> video;
   std::unique_ptr<OutputDirectory> pictures;
   if (args.has("video")) {
     if (type != "obs") throw UsageError("--video shows observations: --type obs");
-    video = std::make_unique<video::EpisodeVideo>(args.text("video"), args.real("fps", 0.01, 1000),
-                                                  args.text("camera"), args.text("attention"),
-                                                  static_cast<int>(args.integer("height", 16, 4096)));
+    video = std::make_unique<video::EpisodeVideo>(args.text("video"), args.real("fps"), args.text("camera"),
+                                                  args.text("attention"), static_cast<int>(args.integer("height")));
   } else {
     pictures = std::make_unique<OutputDirectory>(dir);
   }

@@ -39,7 +39,7 @@ static cli::Usage usage() {
   u.arguments = {cli::input_file()};
   u.options = {
       {"centre", "X,Y,Z", "also voxelize centre +- offset at depth 1 (repeat for several: one batched pass)", "", true},
-      {"offset", "M", "half edge of the deeper grids, metres", "0.15"},
+      cli::real_option("offset", "M", "half edge of the deeper grids, metres", "0.15", 0.001, 10),
       {"octomap-channels", "", "add the free and unknown channels (12 in all)", ""},
       {"png", "DIR", "save a picture of every grid as DIR/<record>.depth<d>[.<k>].png (all at the end, or none)", ""},
   };
@@ -58,7 +58,7 @@ static cli::Usage usage() {
 
 static void run(const cli::Arguments& args) {
   const voxels::GridBounds scene = voxels::parse_scene(args);
-  const double offset = args.real("offset", 0.001, 10);
+  const double offset = args.real("offset");
   std::vector<voxels::GridBounds> crops;
   for (const auto& c : args.all("centre")) {
     const auto p = cli::parse_reals("centre", c, 3);

@@ -8,6 +8,7 @@
 #include "common/indexed_name.hpp"
 #include "robot/robot_model.hpp"
 #include "robot/xarm_export.hpp"
+#include "stream/field_names.hpp"
 #include "stream/reader.hpp"
 
 using namespace qte;
@@ -64,19 +65,20 @@ static void run(const cli::Arguments& args) {
   for (const std::string& file : files) {
     stream::RecordReader reader(file);
     while (auto record = reader.next()) {
-      if (record->type() == "obs" && record->has("gripper_opening_m"))
-        episode.observe_gripper(record->scalar<double>("gripper_opening_m"));
+      if (record->type() == "obs" && record->has(fields::gripper_opening_m))
+        episode.observe_gripper(record->scalar<double>(fields::gripper_opening_m));
       if (record->type() != "trajectory") continue;
       const auto index = static_cast<unsigned long long>(record->position.record_index);
-      if (record->has("failure") && !record->has("time_s")) {
-        std::cerr << "xarm-export: " << file << ": record " << index << ": no motion (" << record->string("failure") << ")\n";
+      if (record->has(fields::failure) && !record->has(fields::time_s)) {
+        std::cerr << "xarm-export: " << file << ": record " << index << ": no motion ("
+                  << record->string(fields::failure) << ")\n";
         continue;
       }
-      const auto times = record->array<double>("time_s");
-      const auto joints = record->array<double>("joint_positions");
+      const auto times = record->array<double>(fields::time_s);
+      const auto joints = record->array<double>(fields::joint_positions);
       if (times.shape.size() != 1 || joints.shape != stream::Shape{times.size(), robot::kArmJoints})
-        record->fail("joint_positions", "float64 [N, 7] with N the length of time_s");
-      const bool open = !record->has("gripper_open") || record->scalar<uint8_t>("gripper_open") != 0;
+        record->fail(fields::joint_positions, "float64 [N, 7] with N the length of time_s");
+      const bool open = !record->has(fields::gripper_open) || record->scalar<uint8_t>(fields::gripper_open) != 0;
       std::vector<robot::XarmRow> rows;
       try {
         rows = episode.motion(times.data, joints.data, times.size(), open);

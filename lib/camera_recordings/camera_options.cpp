@@ -12,7 +12,7 @@ std::vector<cli::OptionSpec> camera_setup_options() {
       {"intrinsics", "FX,FY,CX,CY", "pinhole intrinsics in pixels (needed for depth images)", ""},
       {"camera-pose", "X,Y,Z,QX,QY,QZ,QW", "camera-to-world pose, metres and unit quaternion", ""},
       {"extrinsics", "M00,...,M33", "camera-to-world 4x4 matrix, 16 numbers row by row (instead of --camera-pose)", ""},
-      {"depth-unit", "M", "metres per depth count", "0.001"},
+      cli::real_option("depth-unit", "M", "metres per depth count", "0.001", 1e-6, 1.0),
       cli::no_points_option(),
   };
 }
@@ -28,7 +28,7 @@ CameraSetup camera_setup_from(const cli::Arguments& args) {
     throw UsageError("give the camera's pose: one of --camera-pose and --extrinsics");
   camera.camera_to_world = args.has("camera-pose") ? camera_pose_from_values(args.reals("camera-pose", 7), "camera-pose")
                                                    : camera_pose_from_matrix(args.reals("extrinsics", 16), "extrinsics");
-  camera.depth_unit_m = args.real("depth-unit", 1e-6, 1.0);
+  camera.depth_unit_m = args.real("depth-unit");
   camera.store_points = !args.flag("no-points");
   return camera;
 }

@@ -1,6 +1,7 @@
 #include "camera_recordings/camera_recordings.hpp"
 
 #include "common/error.hpp"
+#include "stream/field_names.hpp"
 
 namespace qte::camera_recordings {
 
@@ -23,19 +24,19 @@ void add_camera_images(stream::Record& obs, const CameraSetup& camera, const cv:
   std::vector<uint16_t> counts(static_cast<std::size_t>(h) * w);
   for (int v = 0; v < h; ++v)
     for (int u = 0; u < w; ++u) counts[static_cast<std::size_t>(v) * w + u] = depth.at<uint16_t>(v, u);
-  obs.set<uint8_t>(camera.name + ".rgb", {h, w, 3}, rgb);
+  obs.set<uint8_t>(camera.name + fields::per_camera::rgb, {h, w, 3}, rgb);
   if (camera.depth_unit_m == 0.001) {
-    obs.set<uint16_t>(camera.name + ".depth_mm", {h, w}, counts);
+    obs.set<uint16_t>(camera.name + fields::per_camera::depth_mm, {h, w}, counts);
   } else {
     std::vector<float> metres(counts.size());
     for (std::size_t i = 0; i < counts.size(); ++i) metres[i] = static_cast<float>(counts[i] * camera.depth_unit_m);
-    obs.set<float>(camera.name + ".depth", {h, w}, metres);
+    obs.set<float>(camera.name + fields::per_camera::depth, {h, w}, metres);
   }
   observation::set_camera_pose(obs, camera.name, camera.intrinsics, camera.camera_to_world);
   if (camera.store_points) {
     // The points every reader would rebuild from the depth, once (plan-path needs them stored).
     for (const voxels::CameraCloud& c : voxels::camera_clouds(obs))
-      if (c.camera == camera.name) obs.set<float>(camera.name + ".points", {h, w, 3}, c.cloud.xyz);
+      if (c.camera == camera.name) obs.set<float>(camera.name + fields::per_camera::points, {h, w, 3}, c.cloud.xyz);
   }
 }
 
@@ -46,8 +47,8 @@ void add_camera_cloud(stream::Record& obs, const CameraSetup& camera, const voxe
     const Eigen::Vector3f q = (camera.camera_to_world * p).cast<float>();  // NaN stays NaN
     world[i] = q.x(), world[i + 1] = q.y(), world[i + 2] = q.z();
   }
-  obs.set<uint8_t>(camera.name + ".rgb", {cloud.height, cloud.width, 3}, cloud.cloud.rgb);
-  obs.set<float>(camera.name + ".points", {cloud.height, cloud.width, 3}, world);
+  obs.set<uint8_t>(camera.name + fields::per_camera::rgb, {cloud.height, cloud.width, 3}, cloud.cloud.rgb);
+  obs.set<float>(camera.name + fields::per_camera::points, {cloud.height, cloud.width, 3}, world);
   observation::set_camera_pose(obs, camera.name, camera.intrinsics, camera.camera_to_world);
 }
 

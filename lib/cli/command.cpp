@@ -25,15 +25,19 @@
 namespace qte::cli {
 namespace {
 
+// Upper bounds that stand for "no bound" (INT64_MAX, 1e30): --help and the errors leave them unsaid.
+constexpr double kUnboundedInteger = 1e15;
+constexpr double kUnboundedReal = 1e30;
+
 // Options every tool has, appended to the tool's own.
 std::vector<OptionSpec> common_options(const Usage& usage) {
   return {
-      {"seed", "N",
-       usage.uses_randomness
-           ? "seed of every random choice this tool makes; same inputs and seed give the same "
-             "output bytes"
-           : "accepted for uniform pipelines; this tool makes no random choices",
-       "0"},
+      integer_option("seed", "N",
+                     usage.uses_randomness
+                         ? "seed of every random choice this tool makes; same inputs and seed give the same "
+                           "output bytes"
+                         : "accepted for uniform pipelines; this tool makes no random choices",
+                     "0", 0, INT64_MAX),
       {"help", "", "print this help and exit", ""},
       {"help-man", "", "print this help as a man page (roff) and exit", ""},
       {"version", "", "print the toolkit version and the commit it was built from, and exit", ""},
@@ -178,10 +182,22 @@ int64_t Arguments::parse_integer(const std::string& name) const {
   throw UsageError("--" + name + ": expected an integer, got '" + v + "'");
 }
 
+// "0..1", "1..4096", "1 or more": a range as --help and the errors write it; a bound past any
+// value a run could use (INT64_MAX, 1e30) is left unsaid.
+static std::string integer_range_text(int64_t lo, int64_t hi) {
+  if (hi >= kUnboundedInteger) return std::to_string(lo) + " or more";
+  return std::to_string(lo) + ".." + std::to_string(hi);
+}
+
+// An integer option's upper bound as an integer (a double of INT64_MAX does not convert back).
+static int64_t integer_high(const OptionSpec& o) {
+  return o.high >= kUnboundedInteger ? INT64_MAX : static_cast<int64_t>(o.high);
+}
+
 int64_t Arguments::integer(const std::string& name, int64_t lo, int64_t hi) const {
   const int64_t n = parse_integer(name);
   if (n < lo || n > hi)
-    throw UsageError("--" + name + " must be " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " + text(name));
+    throw UsageError("--" + name + " must be " + integer_range_text(lo, hi) + ", got " + text(name));
   return n;
 }
 
@@ -196,10 +212,13 @@ double Arguments::parse_real(const std::string& name) const {
   throw UsageError("--" + name + ": expected a number, got '" + v + "'");
 }
 
-// "0..1", "1e-12..1e+30": a real range as --help and the errors write it.
 static std::string real_range_text(double lo, double hi) {
   std::ostringstream range;
-  range << lo << ".." << hi;
+  range << lo;
+  if (hi >= kUnboundedReal)
+    range << " or more";
+  else
+    range << ".." << hi;
   return range.str();
 }
 
@@ -210,19 +229,20 @@ double Arguments::real(const std::string& name, double lo, double hi) const {
   return x;
 }
 
-const OptionSpec& Arguments::ranged(const std::string& name, OptionSpec::Number number) const {
-  const OptionSpec* o = find_option(usage_->options, name);  // a tool's own: common options have no range
+OptionSpec Arguments::ranged(const std::string& name, OptionSpec::Number number) const {
+  const std::vector<OptionSpec> options = all_options(*usage_);
+  const OptionSpec* o = find_option(options, name);
   if (!o || o->number != number) throw Error("internal: option --" + name + " is not declared with its range");
   return *o;
 }
 
 int64_t Arguments::integer(const std::string& name) const {
-  const OptionSpec& o = ranged(name, OptionSpec::Number::integer);
-  return integer(name, static_cast<int64_t>(o.low), static_cast<int64_t>(o.high));
+  const OptionSpec o = ranged(name, OptionSpec::Number::integer);
+  return integer(name, static_cast<int64_t>(o.low), integer_high(o));
 }
 
 double Arguments::real(const std::string& name) const {
-  const OptionSpec& o = ranged(name, OptionSpec::Number::real);
+  const OptionSpec o = ranged(name, OptionSpec::Number::real);
   return real(name, o.low, o.high);
 }
 
@@ -246,7 +266,7 @@ OptionSpec real_option(std::string name, std::string value_name, std::string hel
 
 std::string range_text(const OptionSpec& o) {
   if (o.number == OptionSpec::Number::integer)
-    return std::to_string(static_cast<int64_t>(o.low)) + ".." + std::to_string(static_cast<int64_t>(o.high));
+    return integer_range_text(static_cast<int64_t>(o.low), integer_high(o));
   return real_range_text(o.low, o.high);
 }
 

@@ -114,12 +114,12 @@ class Arguments {
   std::vector<std::string> inputs() const {
     return positional_.empty() ? std::vector<std::string>{"-"} : positional_;
   }
-  uint64_t seed() const { return static_cast<uint64_t>(integer("seed", 0, INT64_MAX)); }
+  uint64_t seed() const { return static_cast<uint64_t>(integer("seed")); }
 
  private:
   int64_t parse_integer(const std::string& name) const;
   double parse_real(const std::string& name) const;
-  const OptionSpec& ranged(const std::string& name, OptionSpec::Number number) const;
+  OptionSpec ranged(const std::string& name, OptionSpec::Number number) const;
   friend Arguments parse(const Usage& usage, const std::vector<std::string>& argv);
   const Usage* usage_ = nullptr;
   std::map<std::string, std::vector<std::string>> given_;

@@ -23,13 +23,14 @@ stream::WriteOptions write_options_from(const Arguments& args, std::vector<std::
 }
 
 OptionSpec max_record_bytes_option() {
-  return {"max-record-bytes", "N", "treat a record payload or decompressed field larger than N bytes as damage",
-          default_text(static_cast<int64_t>(stream::ReadOptions{}.max_record_bytes))};
+  return cli::integer_option("max-record-bytes", "N",
+                             "treat a record payload or decompressed field larger than N bytes as damage",
+                             default_text(static_cast<int64_t>(stream::ReadOptions{}.max_record_bytes)), 1, INT64_MAX);
 }
 
 stream::ReadOptions read_options_from(const Arguments& args) {
   stream::ReadOptions options;
-  options.max_record_bytes = static_cast<uint64_t>(args.integer("max-record-bytes", 1, INT64_MAX));
+  options.max_record_bytes = static_cast<uint64_t>(args.integer("max-record-bytes"));
   return options;
 }
 

@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <vector>
 
+#include "stream/field_names.hpp"
+
 namespace qte::demos {
 namespace {
 
@@ -17,8 +19,8 @@ struct Attempt {
 
 Attempt run_episode(sim_step::Simulator& sim, planning::PlanPathFilter& planner, const stream::Record& reset) {
   Attempt attempt;
-  attempt.seed = reset.scalar<int64_t>("seed");
-  attempt.variation = reset.scalar<int32_t>("variation");
+  attempt.seed = reset.scalar<int64_t>(fields::seed);
+  attempt.variation = reset.scalar<int32_t>(fields::variation);
   auto keep = [&](const stream::Record& r) { attempt.records.push_back(r); };
   sim.handle(reset, keep);
   // Waypoints are fixed at the start, from the scene as it was reset (as RLBench's are).
@@ -35,8 +37,9 @@ Attempt run_episode(sim_step::Simulator& sim, planning::PlanPathFilter& planner,
     sim.handle(planned.back(), keep);  // the trajectory (or failure)
   }
   const stream::Record& last = attempt.records.back();
-  attempt.success = last.scalar<uint8_t>("success") != 0;
-  if (last.has("failure")) attempt.failure = last.string("failure");
+  attempt.success = last.scalar<uint8_t>(fields::success) != 0;
+  if (last.has(fields::failure))
+    attempt.failure = last.string(fields::failure);
   else if (!attempt.success) attempt.failure = "expert_did_not_succeed";
   return attempt;
 }
@@ -64,14 +67,14 @@ DemoSummary record_demos(const robot::RobotModel& robot, DemoOptions options,
     } while (!attempt.success && attempts <= options.retries);
     for (const auto& r : attempt.records) emit(r);
     stream::Record episode("episode");
-    episode.set_string("task", options.episodes.task);
-    episode.set_scalar<int32_t>("episode", e);
-    episode.set_scalar<int32_t>("variation", attempt.variation);
-    episode.set_scalar<int64_t>("seed", attempt.seed);
-    episode.set_scalar<uint8_t>("success", attempt.success);
-    episode.set_scalar<int32_t>("frames", static_cast<int32_t>(attempt.records.size()));
-    episode.set_scalar<int32_t>("attempts", attempts);
-    if (!attempt.failure.empty()) episode.set_string("failure", attempt.failure);
+    episode.set_string(fields::task, options.episodes.task);
+    episode.set_scalar<int32_t>(fields::episode, e);
+    episode.set_scalar<int32_t>(fields::variation, attempt.variation);
+    episode.set_scalar<int64_t>(fields::seed, attempt.seed);
+    episode.set_scalar<uint8_t>(fields::success, attempt.success);
+    episode.set_scalar<int32_t>(fields::frames, static_cast<int32_t>(attempt.records.size()));
+    episode.set_scalar<int32_t>(fields::attempts, attempts);
+    if (!attempt.failure.empty()) episode.set_string(fields::failure, attempt.failure);
     emit(episode);
     summary.episodes += 1;
     summary.successes += attempt.success;

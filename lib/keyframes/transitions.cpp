@@ -7,6 +7,7 @@
 #include "keyframes/keyframes.hpp"
 #include "robot/pose_values.hpp"
 #include "robot/rotation_bins.hpp"
+#include "stream/field_names.hpp"
 #include "tasks/episode.hpp"
 #include "voxels/grid_fields.hpp"
 #include "voxels/observation_cloud.hpp"
@@ -22,21 +23,23 @@ uint64_t fnv1a(const void* data, std::size_t n, uint64_t h = 1469598103934665603
 }
 
 Eigen::Isometry3d gripper_pose(const stream::Record& obs) {
-  const auto p = obs.array<double>("gripper_pose");
-  if (p.size() != robot::kPoseValues) obs.fail("gripper_pose", "float64 [7]");
+  const auto p = obs.array<double>(fields::gripper_pose);
+  if (p.size() != robot::kPoseValues) obs.fail(fields::gripper_pose, "float64 [7]");
   const double norm = std::sqrt(p[3] * p[3] + p[4] * p[4] + p[5] * p[5] + p[6] * p[6]);
   for (int i = 0; i < robot::kPoseValues; ++i)
-    if (!std::isfinite(p[i])) obs.fail("gripper_pose", "finite position and quaternion");
-  if (!(norm > 0.5 && norm < 1.5)) obs.fail("gripper_pose", "a unit quaternion (x, y, z, w), got norm " + std::to_string(norm));
+    if (!std::isfinite(p[i])) obs.fail(fields::gripper_pose, "finite position and quaternion");
+  if (!(norm > 0.5 && norm < 1.5))
+    obs.fail(fields::gripper_pose, "a unit quaternion (x, y, z, w), got norm " + std::to_string(norm));
   return robot::pose_from_values(p.data);
 }
 
 // The episode's key: what identifies it, hashed (frames refer to it across appended files).
 int64_t episode_key_of(const std::vector<stream::Record>& episode, uint64_t seed) {
-  const std::string task = episode[0].has("task") ? episode[0].string("task") : "";
+  const std::string task = episode[0].has(fields::task) ? episode[0].string(fields::task) : "";
   uint64_t key = fnv1a(task.data(), task.size());
-  const int64_t episode_seed = episode[0].has("episode_seed") ? episode[0].scalar<int64_t>("episode_seed") : 0;
-  const auto last_pose = episode.back().array<double>("gripper_pose");
+  const int64_t episode_seed =
+      episode[0].has(fields::episode_seed) ? episode[0].scalar<int64_t>(fields::episode_seed) : 0;
+  const auto last_pose = episode.back().array<double>(fields::gripper_pose);
   key = fnv1a(&episode_seed, sizeof episode_seed, key);
   key = fnv1a(last_pose.data, 7 * sizeof(double), key);
   return static_cast<int64_t>(derive_seed(key, seed));
@@ -61,9 +64,9 @@ AgentEpisodeConverter::AgentEpisodeConverter(TransitionOptions options) : option
 
 void AgentEpisodeConverter::handle(const stream::Record& record, const stream::Emit& emit) {
   if (record.type() == "obs") {
-    if (!observations_.empty() && record.scalar<int32_t>("step") == 0) convert(emit);  // a new episode
+    if (!observations_.empty() && record.scalar<int32_t>(fields::step) == 0) convert(emit);  // a new episode
     observations_.push_back(record);
-    if (record.scalar<uint8_t>("terminal") != 0) convert(emit);
+    if (record.scalar<uint8_t>(fields::terminal) != 0) convert(emit);
   } else if (record.type() == "action" && !observations_.empty()) {
     if (actions_.size() + 1 != observations_.size())
       throw StreamError(record.position, "'action' record without an observation of its own before it");
@@ -86,40 +89,44 @@ void AgentEpisodeConverter::convert(const stream::Emit& emit) {
     for (std::size_t t = 0; t < steps; ++t) {
       const stream::Record &obs = observations_[t], &action = actions_[t], &next = observations_[t + 1];
       stream::Record r("transition");
-      r.set_scalar<int64_t>("episode_key", episode_key);
-      r.set_scalar<int32_t>("frame", obs.scalar<int32_t>("frame"));
-      r.set_scalar<int32_t>("next_frame", next.scalar<int32_t>("frame"));
-      r.set_scalar<int32_t>("step", obs.scalar<int32_t>("step"));
-      r.set_scalar<int32_t>("voxels", h.voxels());
+      r.set_scalar<int64_t>(fields::episode_key, episode_key);
+      r.set_scalar<int32_t>(fields::frame, obs.scalar<int32_t>(fields::frame));
+      r.set_scalar<int32_t>(fields::next_frame, next.scalar<int32_t>(fields::frame));
+      r.set_scalar<int32_t>(fields::step, obs.scalar<int32_t>(fields::step));
+      r.set_scalar<int32_t>(fields::voxels, h.voxels());
       for (int d = 0; d < h.depths; ++d) {
-        const std::string prefix = "depth" + std::to_string(d);
-        const auto index = action.array<int32_t>(prefix + ".index");
-        const auto bounds = action.array<double>(prefix + ".bounds");
-        if (index.size() != 3) action.fail(prefix + ".index", "int32 [3]");
-        if (bounds.size() != 4) action.fail(prefix + ".bounds", "float64 [4]");
+        const auto index = action.array<int32_t>(fields::depth_field(d, fields::per_depth::index));
+        const auto bounds = action.array<double>(fields::depth_field(d, fields::per_depth::bounds));
+        if (index.size() != 3) action.fail(fields::depth_field(d, fields::per_depth::index), "int32 [3]");
+        if (bounds.size() != 4) action.fail(fields::depth_field(d, fields::per_depth::bounds), "float64 [4]");
         for (int axis = 0; axis < 3; ++axis)
           if (index[axis] < 0 || index[axis] >= h.voxels())
-            action.fail(prefix + ".index", "indices in 0.." + std::to_string(h.voxels() - 1) + " (--voxels)");
-        action.require_finite(prefix + ".bounds");
-        if (!(bounds[3] > 0)) action.fail(prefix + ".bounds", "a positive edge length (x, y, z, size in metres)");
-        r.add(action.field(prefix + ".index"));
-        r.add(action.field(prefix + ".bounds"));
+            action.fail(fields::depth_field(d, fields::per_depth::index),
+                        "indices in 0.." + std::to_string(h.voxels() - 1) + " (--voxels)");
+        action.require_finite(fields::depth_field(d, fields::per_depth::bounds));
+        if (!(bounds[3] > 0))
+          action.fail(fields::depth_field(d, fields::per_depth::bounds),
+                      "a positive edge length (x, y, z, size in metres)");
+        r.add(action.field(fields::depth_field(d, fields::per_depth::index)));
+        r.add(action.field(fields::depth_field(d, fields::per_depth::bounds)));
       }
-      if (action.has("depth" + std::to_string(h.depths) + ".index"))
-        action.fail("depth" + std::to_string(h.depths) + ".index",
+      if (action.has(fields::depth_field(h.depths, fields::per_depth::index)))
+        action.fail(fields::depth_field(h.depths, fields::per_depth::index),
                     "no more than " + std::to_string(h.depths) + " depths (--depths)");
-      r.add(action.field("rotation_bins"));
-      r.set_scalar<uint8_t>("gripper_open", action.has("gripper_open") ? action.scalar<uint8_t>("gripper_open") : 1);
-      r.set_scalar<uint8_t>("ignore_collisions",
-                            action.has("ignore_collisions") ? action.scalar<uint8_t>("ignore_collisions") : 0);
-      const auto pose = action.array<double>("pose");
-      if (pose.size() != robot::kPoseValues) action.fail("pose", "float64 [7]");
-      action.require_finite("pose");
-      next.require_finite("reward");
-      r.set<double>("target_pose", {robot::kPoseValues}, pose.data);
-      r.set_scalar<float>("reward", next.scalar<float>("reward"));
-      r.set_scalar<uint8_t>("terminal", next.scalar<uint8_t>("terminal"));
-      r.set_scalar<uint8_t>("demo", 0);
+      r.add(action.field(fields::rotation_bins));
+      r.set_scalar<uint8_t>(fields::gripper_open,
+                            action.has(fields::gripper_open) ? action.scalar<uint8_t>(fields::gripper_open) : 1);
+      r.set_scalar<uint8_t>(fields::ignore_collisions, action.has(fields::ignore_collisions)
+                                                           ? action.scalar<uint8_t>(fields::ignore_collisions)
+                                                           : 0);
+      const auto pose = action.array<double>(fields::pose);
+      if (pose.size() != robot::kPoseValues) action.fail(fields::pose, "float64 [7]");
+      action.require_finite(fields::pose);
+      next.require_finite(fields::reward);
+      r.set<double>(fields::target_pose, {robot::kPoseValues}, pose.data);
+      r.set_scalar<float>(fields::reward, next.scalar<float>(fields::reward));
+      r.set_scalar<uint8_t>(fields::terminal, next.scalar<uint8_t>(fields::terminal));
+      r.set_scalar<uint8_t>(fields::demo, 0);
       if (t == 0) emit(frame_record(obs, episode_key));
       emit(frame_record(next, episode_key));
       counts_.frames += t == 0 ? 2 : 1;
@@ -134,34 +141,36 @@ void AgentEpisodeConverter::convert(const stream::Emit& emit) {
 
 stream::Record frame_record(const stream::Record& obs, int64_t episode_key) {
   stream::Record frame("frame");
-  frame.set_scalar<int64_t>("episode_key", episode_key);
-  frame.set_scalar<int32_t>("frame", obs.scalar<int32_t>("frame"));
+  frame.set_scalar<int64_t>(fields::episode_key, episode_key);
+  frame.set_scalar<int32_t>(fields::frame, obs.scalar<int32_t>(fields::frame));
   for (const auto& field : obs.fields()) {
     const std::string& name = field.name();
-    if (stream::ends_with(name, ".rgb")) {
+    if (stream::ends_with(name, fields::per_camera::rgb)) {
       stream::Field rgb = field;  // read compressed: its zstd frame is written as it came
       rgb.compress = true;
       frame.add(rgb);
-    } else if (stream::ends_with(name, ".depth")) {
+    } else if (stream::ends_with(name, fields::per_camera::depth)) {
       // Millimetres in 16 bits: 0.5 mm rounding, far below a 1.9 cm voxel, half the bytes.
       const auto depth = obs.array<float>(name);
       frame.set<uint16_t>(name + "_mm", depth.shape, voxels::depth_in_mm(depth.data, depth.size()), /*compress=*/true);
-    } else if (stream::ends_with(name, ".depth_mm")) {  // a depth camera's own millimetres (obs-pack)
+    } else if (stream::ends_with(name, fields::per_camera::depth_mm)) {  // a depth camera's own millimetres (obs-pack)
       stream::Field mm = field;
       mm.compress = true;
       frame.add(mm);
-    } else if (stream::ends_with(name, ".intrinsics") || stream::ends_with(name, ".extrinsics")) {
+    } else if (stream::ends_with(name, fields::per_camera::intrinsics) ||
+               stream::ends_with(name, fields::per_camera::extrinsics)) {
       frame.add(field);
     }
   }
-  for (const char* name : {"joint_positions", "gripper_pose", "gripper_open", "gripper_opening_m", "episode_length", "task",
-                           "variation"})
+  for (const char* name : {fields::joint_positions, fields::gripper_pose, fields::gripper_open,
+                           fields::gripper_opening_m, fields::episode_length, fields::task, fields::variation})
     if (obs.has(name)) frame.add(obs.field(name));
   // Nothing non-finite reaches the replay: every real value kept is checked at its source
   // (depth is stored as millimetres, where no return is 0).
   for (const auto& field : frame.fields())
     if (field.dtype() == stream::DType::f32 || field.dtype() == stream::DType::f64) obs.require_finite(field.name());
-  for (const std::string& camera : obs.prefixes(".extrinsics")) voxels::check_camera_matrices(obs, camera);
+  for (const std::string& camera : obs.prefixes(fields::per_camera::extrinsics))
+    voxels::check_camera_matrices(obs, camera);
   return frame;
 }
 
@@ -172,7 +181,7 @@ void EpisodeConverter::handle(const stream::Record& record, const stream::Emit& 
     convert(episode_, &record, emit);
     episode_.clear();
   } else if (record.type() == "obs") {
-    if (!episode_.empty() && record.scalar<int32_t>("frame") == 0) {
+    if (!episode_.empty() && record.scalar<int32_t>(fields::frame) == 0) {
       convert(episode_, nullptr, emit);
       episode_.clear();
     }
@@ -192,11 +201,12 @@ std::vector<int> EpisodeConverter::usable_keyframes(const std::vector<stream::Re
     return {};
   }
   for (std::size_t i = 1; i < episode.size(); ++i)
-    if (episode[i].scalar<int32_t>("frame") != episode[i - 1].scalar<int32_t>("frame") + 1) {
+    if (episode[i].scalar<int32_t>(fields::frame) != episode[i - 1].scalar<int32_t>(fields::frame) + 1) {
       counts_.skipped_out_of_order += 1;
       return {};
     }
-  success = summary ? summary->scalar<uint8_t>("success") != 0 : episode.back().scalar<uint8_t>("success") != 0;
+  success =
+      summary ? summary->scalar<uint8_t>(fields::success) != 0 : episode.back().scalar<uint8_t>(fields::success) != 0;
   if (!success && !options_.keep_failed) {
     counts_.skipped_failed += 1;
     return {};
@@ -204,9 +214,9 @@ std::vector<int> EpisodeConverter::usable_keyframes(const std::vector<stream::Re
   std::vector<FrameState> states;
   for (const auto& obs : episode) {
     FrameState s;
-    s.gripper_open = obs.scalar<uint8_t>("gripper_open") != 0;
-    const auto v = obs.array<double>("joint_velocities");
-    if (v.size() != 7) obs.fail("joint_velocities", "float64 [7]");
+    s.gripper_open = obs.scalar<uint8_t>(fields::gripper_open) != 0;
+    const auto v = obs.array<double>(fields::joint_velocities);
+    if (v.size() != 7) obs.fail(fields::joint_velocities, "float64 [7]");
     std::copy(v.begin(), v.end(), s.joint_velocities.begin());
     states.push_back(s);
   }
@@ -276,29 +286,28 @@ stream::Record EpisodeConverter::transition(const std::vector<stream::Record>& e
   const auto indices = h.indices_of(pose.translation(), shifts);
 
   stream::Record t("transition");
-  t.set_scalar<int64_t>("episode_key", episode_key);
-  t.set_scalar<int32_t>("frame", episode[from].scalar<int32_t>("frame"));
-  t.set_scalar<int32_t>("next_frame", target.scalar<int32_t>("frame"));
-  t.set_scalar<int32_t>("step", step);
-  t.set_scalar<int32_t>("voxels", h.voxels());
+  t.set_scalar<int64_t>(fields::episode_key, episode_key);
+  t.set_scalar<int32_t>(fields::frame, episode[from].scalar<int32_t>(fields::frame));
+  t.set_scalar<int32_t>(fields::next_frame, target.scalar<int32_t>(fields::frame));
+  t.set_scalar<int32_t>(fields::step, step);
+  t.set_scalar<int32_t>(fields::voxels, h.voxels());
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   for (int d = 0; d < h.depths; ++d) {
     if (d > 0) centre += shifts[d];
     const voxels::GridBounds b = h.bounds_at(d, centre);
-    const std::string prefix = "depth" + std::to_string(d);
-    t.set<int32_t>(prefix + ".index", {3}, indices[d].data());
-    t.set<double>(prefix + ".bounds", {4}, voxels::bounds_values(b));
+    t.set<int32_t>(fields::depth_field(d, fields::per_depth::index), {3}, indices[d].data());
+    t.set<double>(fields::depth_field(d, fields::per_depth::bounds), {4}, voxels::bounds_values(b));
     centre = b.centre_of(indices[d]);
   }
   const Eigen::Vector3i bins = robot::rotation_bins(pose.linear());
-  t.set<int32_t>("rotation_bins", {3}, bins.data());
-  t.set_scalar<uint8_t>("gripper_open", target.scalar<uint8_t>("gripper_open"));
-  t.set_scalar<uint8_t>("ignore_collisions",
-                        target.has("ignore_collisions") ? target.scalar<uint8_t>("ignore_collisions") : 0);
-  t.set<double>("target_pose", {robot::kPoseValues}, robot::pose_values(pose));
-  t.set_scalar<float>("reward", last && success ? tasks::kSuccessReward : 0.0f);
-  t.set_scalar<uint8_t>("terminal", last);
-  t.set_scalar<uint8_t>("demo", options_.demo);
+  t.set<int32_t>(fields::rotation_bins, {3}, bins.data());
+  t.set_scalar<uint8_t>(fields::gripper_open, target.scalar<uint8_t>(fields::gripper_open));
+  t.set_scalar<uint8_t>(fields::ignore_collisions,
+                        target.has(fields::ignore_collisions) ? target.scalar<uint8_t>(fields::ignore_collisions) : 0);
+  t.set<double>(fields::target_pose, {robot::kPoseValues}, robot::pose_values(pose));
+  t.set_scalar<float>(fields::reward, last && success ? tasks::kSuccessReward : 0.0f);
+  t.set_scalar<uint8_t>(fields::terminal, last);
+  t.set_scalar<uint8_t>(fields::demo, options_.demo);
   return t;
 }
 

@@ -21,7 +21,7 @@ std::vector<cli::OptionSpec> learner_config_options() {
   const LearnerConfig d;
   return {
       {"architecture", "A", "network per depth: light or arm", nets::architecture_name(d.net.architecture)},
-      {"base-channels", "C", "first-level kernels (default: light 16, arm 64)", ""},
+      cli::integer_option("base-channels", "C", "first-level kernels (default: light 16, arm 64)", "", 1, 512),
       cli::integer_option("batch", "B", "transitions per step (published: 128)", default_text(d.batch), 1, 100000),
       cli::real_option("gamma", "G", "discount", default_text(d.gamma), 0, 1),
       cli::real_option("reward-scale", "F", "reward multiplier in the target", default_text(d.reward_scale), 1e-9, 1e9),
@@ -49,7 +49,7 @@ std::vector<cli::OptionSpec> learner_config_options() {
 LearnerConfig learner_config_from(const cli::Arguments& args) {
   LearnerConfig config;
   config.net.architecture = nets::architecture_from_name(args.text("architecture"));
-  config.net.base_channels = args.has("base-channels") ? static_cast<int>(args.integer("base-channels", 1, 512))
+  config.net.base_channels = args.has("base-channels") ? static_cast<int>(args.integer("base-channels"))
                                                        : nets::default_base_channels(config.net.architecture);
   config.hierarchy = voxels::parse_hierarchy(args, 4, 128);  // the networks' smallest and largest grids
   config.batch = static_cast<int>(args.integer("batch"));
@@ -110,7 +110,7 @@ LoopOptions loop_options_from(const cli::Arguments& args) {
   loop.log_every = args.integer("log-every");
   loop.metrics_path = args.text("metrics");
   loop.seed = args.seed();
-  loop.threads = static_cast<int>(args.integer("threads", 1, 256));
+  loop.threads = static_cast<int>(args.integer("threads"));
   return loop;
 }
 

@@ -6,6 +6,7 @@
 #include "common/error.hpp"
 #include "nets/checkpoint.hpp"
 #include "nets/qattention_modules.hpp"
+#include "stream/field_names.hpp"
 #include "stream/reader.hpp"
 #include "stream/writer.hpp"
 #include "voxels/grid_fields.hpp"
@@ -137,10 +138,10 @@ StepStats QLearner::gradients(const Minibatch& batch) {
 
 void QLearner::save(const std::string& path, const stream::Record& extra) const {
   stream::Record online = nets::checkpoint_record(torch_->online, torch_->adam.get(), step_);
-  online.set_string("learner", config_.json());
+  online.set_string(fields::learner, config_.json());
   voxels::set_hierarchy(online, config_.hierarchy);
   stream::Record target = nets::checkpoint_record(torch_->target, nullptr, step_);
-  target.set_string("role", "target");
+  target.set_string(fields::role, "target");
   stream::RecordWriter writer(path, {stream::WriteMode::replace});
   writer.write(online);
   writer.write(target);
@@ -154,18 +155,19 @@ stream::Record QLearner::load(const std::string& path) {
   std::optional<stream::Record> online, target, extra;
   while (auto record = reader.next()) {
     std::optional<stream::Record>& slot = record->type() != "checkpoint" ? extra
-                                          : record->has("role") && record->string("role") == "target" ? target
-                                                                                                      : online;
+                                          : record->has(fields::role) && record->string(fields::role) == "target"
+                                              ? target
+                                              : online;
     if (slot) throw StreamError(record->position, "a second '" + record->type() + "' record of this role: expected a learner checkpoint (online 'checkpoint', target 'checkpoint', the learner's state)");
     slot = std::move(record);
   }
   if (!online || !target || !extra)
     throw StreamError({path, reader.records_read(), reader.byte_offset()}, "expected a learner checkpoint (online 'checkpoint', target 'checkpoint', "
                                          "and the learner's state), the file ends early");
-  if (!online->has("learner") || !target->has("role") || target->string("role") != "target")
+  if (!online->has(fields::learner) || !target->has(fields::role) || target->string(fields::role) != "target")
     throw StreamError(online->position, "not a learner checkpoint (no 'learner' settings and target networks): "
                                         "a checkpoint of networks only cannot be resumed");
-  const std::string had = online->string("learner"), want = config_.json();
+  const std::string had = online->string(fields::learner), want = config_.json();
   if (had != want)
     throw Error(path + ": the checkpoint was trained with other settings: " + had + "; this run has " + want);
   step_ = nets::load_checkpoint_record(*online, torch_->online, torch_->adam.get());

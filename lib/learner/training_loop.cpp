@@ -16,6 +16,7 @@
 #include "common/atomic_file.hpp"
 #include "common/error.hpp"
 #include "common/random.hpp"
+#include "stream/field_names.hpp"
 #include "stream/record_types.hpp"
 
 namespace qte::learner {
@@ -27,7 +28,7 @@ bool exists(const std::string& path) {
 }
 
 bool is_agent_transition(const stream::Record& r) {
-  return r.type() == "transition" && !(r.has("demo") && r.scalar<uint8_t>("demo") != 0);
+  return r.type() == "transition" && !(r.has(fields::demo) && r.scalar<uint8_t>(fields::demo) != 0);
 }
 
 // With an adaptive tree target, the mean branches it expanded at depths 1.. come last.
@@ -114,14 +115,14 @@ void TrainingLoop::ingest(int64_t agent_limit, bool fill_to_start_after, int64_t
 
 void TrainingLoop::save() {
   stream::Record state("learner");
-  state.set_scalar<int64_t>("step", learner_.step());
-  state.set_scalar<int64_t>("transitions_read", transitions_read_);
-  state.set_scalar<int64_t>("agent_transitions", agent_transitions_);
-  state.set_scalar<int64_t>("seed", static_cast<int64_t>(options_.seed));
-  state.set_scalar<int64_t>("threads", options_.threads);
+  state.set_scalar<int64_t>(fields::step, learner_.step());
+  state.set_scalar<int64_t>(fields::transitions_read, transitions_read_);
+  state.set_scalar<int64_t>(fields::agent_transitions, agent_transitions_);
+  state.set_scalar<int64_t>(fields::seed, static_cast<int64_t>(options_.seed));
+  state.set_scalar<int64_t>(fields::threads, options_.threads);
   const std::vector<double> priorities = replay_.priorities();
-  state.set<double>("priorities", {static_cast<int64_t>(priorities.size())}, priorities, /*compress=*/true);
-  state.set_scalar<double>("max_priority", replay_.max_priority());
+  state.set<double>(fields::priorities, {static_cast<int64_t>(priorities.size())}, priorities, /*compress=*/true);
+  state.set_scalar<double>(fields::max_priority, replay_.max_priority());
   learner_.save(checkpoints_.path_for(learner_.step()), state);
   checkpoints_.publish(learner_.step());
   last_saved_ = learner_.step();
@@ -134,13 +135,14 @@ bool TrainingLoop::start(bool resume) {
   if (resume && exists(checkpoints_.latest())) {
     const stream::Record state = learner_.load(checkpoints_.latest());
     // Another seed or thread count would continue as another run (other batches, other sums).
-    for (const auto& [name, value] : {std::pair<const char*, int64_t>{"seed", static_cast<int64_t>(options_.seed)},
-                                      std::pair<const char*, int64_t>{"threads", options_.threads}})
+    for (const auto& [name, value] :
+         {std::pair<const char*, int64_t>{fields::seed, static_cast<int64_t>(options_.seed)},
+          std::pair<const char*, int64_t>{fields::threads, options_.threads}})
       if (state.has(name) && state.scalar<int64_t>(name) != value)
         throw UsageError(checkpoints_.latest() + ": the run was started with --" + name + " " +
                          std::to_string(state.scalar<int64_t>(name)) + "; resume it with the same, not " +
                          std::to_string(value));
-    const int64_t want = state.scalar<int64_t>("transitions_read");
+    const int64_t want = state.scalar<int64_t>(fields::transitions_read);
     while (true) {  // the inputs up to where the checkpoint was taken
       ingest(INT64_MAX, false, want);
       if (transitions_read_ >= want) break;
@@ -156,9 +158,9 @@ bool TrainingLoop::start(bool resume) {
                     ": they lost records since; rebuild the replay, or start over with --overwrite");
       std::this_thread::sleep_for(options_.poll);
     }
-    const auto priorities = state.array<double>("priorities");
+    const auto priorities = state.array<double>(fields::priorities);
     replay_.restore_priorities(std::vector<double>(priorities.begin(), priorities.end()),
-                               state.has("max_priority") ? state.scalar<double>("max_priority") : 1.0);
+                               state.has(fields::max_priority) ? state.scalar<double>(fields::max_priority) : 1.0);
     last_saved_ = learner_.step();
     progress_ << "qattn-train: resumed at step " << learner_.step() << " with " << transitions_read_
               << " transitions\n";

@@ -6,6 +6,7 @@
 
 #include "common/error.hpp"
 #include "nets/qattention_modules.hpp"
+#include "stream/field_names.hpp"
 #include "stream/reader.hpp"
 #include "stream/writer.hpp"
 
@@ -21,8 +22,6 @@ std::vector<std::pair<std::string, torch::Tensor>> named_tensors(const QAttentio
   for (const auto& b : module.named_buffers()) tensors.emplace_back(b.key(), b.value());
   return tensors;
 }
-
-std::string depth_prefix(int depth) { return "depth" + std::to_string(depth) + "."; }
 
 // Adam keys its per-parameter state by the parameter's TensorImpl (as torch/optim/serialize.h).
 std::string adam_key(const torch::Tensor& parameter) { return c10::guts::to_string(parameter.unsafeGetTensorImpl()); }
@@ -61,7 +60,7 @@ CheckpointConfig stack_config(const std::vector<QAttentionNet>& nets) {
 bool is_tensor_name(const std::string& name) {
   const bool depth_tensor =
       name.rfind("depth", 0) == 0 && name.size() > 5 && std::isdigit(static_cast<unsigned char>(name[5]));
-  return depth_tensor || name.rfind("adam.", 0) == 0;
+  return depth_tensor || name.rfind(fields::adam_prefix, 0) == 0;
 }
 
 // One tensor to load: where it comes from and where it goes.
@@ -75,28 +74,29 @@ struct PendingCopy {
 stream::Record checkpoint_record(const std::vector<QAttentionNet>& nets, const torch::optim::Adam* adam, int64_t step) {
   CheckpointConfig config = stack_config(nets);
   stream::Record record("checkpoint");
-  record.set_string("architecture", architecture_name(config.net.architecture));
-  record.set_scalar<int64_t>("base_channels", config.net.base_channels);
-  record.set_scalar<int64_t>("voxels", config.net.voxels);
-  record.set_scalar<int64_t>("channels", config.net.channels);
-  record.set_scalar<int64_t>("proprio", config.net.proprio);
-  record.set_scalar<int64_t>("depths", config.depths);
-  record.set_scalar<int64_t>("step", step);
-  record.set_string("config", config_json(config));
+  record.set_string(fields::architecture, architecture_name(config.net.architecture));
+  record.set_scalar<int64_t>(fields::base_channels, config.net.base_channels);
+  record.set_scalar<int64_t>(fields::voxels, config.net.voxels);
+  record.set_scalar<int64_t>(fields::channels, config.net.channels);
+  record.set_scalar<int64_t>(fields::proprio, config.net.proprio);
+  record.set_scalar<int64_t>(fields::depths, config.depths);
+  record.set_scalar<int64_t>(fields::step, step);
+  record.set_string(fields::config, config_json(config));
   for (const auto& net : nets)
     for (const auto& [name, tensor] : named_tensors(net.module()))
-      set_tensor(record, depth_prefix(net.config().depth) + name, tensor);
+      set_tensor(record, fields::depth_prefix(net.config().depth) + name, tensor);
   if (adam == nullptr) return record;
   for (const auto& net : nets) {
     for (const auto& p : net.module().named_parameters()) {
       const auto found = adam->state().find(adam_key(p.value()));
       if (found == adam->state().end()) continue;  // never stepped: no state yet
       const auto& state = static_cast<const AdamParamState&>(*found->second);
-      const std::string name = "adam." + depth_prefix(net.config().depth) + p.key();
-      set_tensor(record, name + ".exp_avg", state.exp_avg());
-      set_tensor(record, name + ".exp_avg_sq", state.exp_avg_sq());
-      if (state.max_exp_avg_sq().defined()) set_tensor(record, name + ".max_exp_avg_sq", state.max_exp_avg_sq());
-      record.set_scalar<int64_t>(name + ".step", state.step());
+      const std::string name = fields::adam_prefix + fields::depth_prefix(net.config().depth) + p.key();
+      set_tensor(record, name + fields::per_parameter::exp_avg, state.exp_avg());
+      set_tensor(record, name + fields::per_parameter::exp_avg_sq, state.exp_avg_sq());
+      if (state.max_exp_avg_sq().defined())
+        set_tensor(record, name + fields::per_parameter::max_exp_avg_sq, state.max_exp_avg_sq());
+      record.set_scalar<int64_t>(name + fields::per_parameter::step, state.step());
     }
   }
   return record;
@@ -122,17 +122,17 @@ CheckpointConfig checkpoint_config(const stream::Record& record) {
     return static_cast<int>(v);
   };
   CheckpointConfig config;
-  const std::string architecture = record.string("architecture");
+  const std::string architecture = record.string(fields::architecture);
   if (architecture != "arm" && architecture != "light")
     throw StreamError(record.position, "'checkpoint' record: unknown architecture '" + architecture + "'");
   config.net.architecture = architecture_from_name(architecture);
-  config.net.base_channels = integer("base_channels", 1, 512);
-  config.net.voxels = integer("voxels", 4, 128);
-  config.net.channels = integer("channels", 1, 64);
-  config.net.proprio = integer("proprio", 1, 64);
-  config.depths = integer("depths", 1, 8);
+  config.net.base_channels = integer(fields::base_channels, 1, 512);
+  config.net.voxels = integer(fields::voxels, 4, 128);
+  config.net.channels = integer(fields::channels, 1, 64);
+  config.net.proprio = integer(fields::proprio, 1, 64);
+  config.depths = integer(fields::depths, 1, 8);
   config.net.is_last = config.depths == 1;
-  config.step = record.scalar<int64_t>("step");
+  config.step = record.scalar<int64_t>(fields::step);
   return config;
 }
 
@@ -140,7 +140,7 @@ stream::Record read_online_checkpoint(const std::string& path) {
   stream::RecordReader reader(path);
   std::optional<stream::Record> online;
   while (std::optional<stream::Record> record = reader.next()) {
-    if (record->type() != "checkpoint" || record->has("role")) continue;
+    if (record->type() != "checkpoint" || record->has(fields::role)) continue;
     if (online)
       throw StreamError(record->position, "a second online 'checkpoint' record (the first is record " +
                                               std::to_string(online->position.record_index) +
@@ -166,12 +166,12 @@ int64_t load_checkpoint_record(const stream::Record& record, std::vector<QAttent
   const auto compare = [&](const char* name, const std::string& in_file, const std::string& in_nets) {
     if (in_file != in_nets) refuse(std::string(name) + " is " + in_file + ", the networks have " + in_nets);
   };
-  compare("architecture", architecture_name(have.net.architecture), architecture_name(want.net.architecture));
-  compare("base_channels", std::to_string(have.net.base_channels), std::to_string(want.net.base_channels));
-  compare("voxels", std::to_string(have.net.voxels), std::to_string(want.net.voxels));
-  compare("channels", std::to_string(have.net.channels), std::to_string(want.net.channels));
-  compare("proprio", std::to_string(have.net.proprio), std::to_string(want.net.proprio));
-  compare("depths", std::to_string(have.depths), std::to_string(want.depths));
+  compare(fields::architecture, architecture_name(have.net.architecture), architecture_name(want.net.architecture));
+  compare(fields::base_channels, std::to_string(have.net.base_channels), std::to_string(want.net.base_channels));
+  compare(fields::voxels, std::to_string(have.net.voxels), std::to_string(want.net.voxels));
+  compare(fields::channels, std::to_string(have.net.channels), std::to_string(want.net.channels));
+  compare(fields::proprio, std::to_string(have.net.proprio), std::to_string(want.net.proprio));
+  compare(fields::depths, std::to_string(have.depths), std::to_string(want.depths));
 
   std::set<std::string> known;  // every field a network or Adam accounts for
   const auto checked_field = [&](const std::string& name, const torch::Tensor& like) -> const stream::Field& {
@@ -189,7 +189,7 @@ int64_t load_checkpoint_record(const stream::Record& record, std::vector<QAttent
   std::vector<PendingCopy> copies;
   for (auto& net : nets)
     for (const auto& [name, tensor] : named_tensors(net.module()))
-      copies.push_back({&checked_field(depth_prefix(net.config().depth) + name, tensor), tensor});
+      copies.push_back({&checked_field(fields::depth_prefix(net.config().depth) + name, tensor), tensor});
 
   // Adam: per parameter, all of its state or none (a parameter that never had a gradient).
   std::map<std::string, AdamParamState> adam_states;  // by adam_key
@@ -199,22 +199,24 @@ int64_t load_checkpoint_record(const stream::Record& record, std::vector<QAttent
       for (const auto& p : group.params()) optimised.insert(adam_key(p));
   for (auto& net : nets) {
     for (const auto& p : net.module().named_parameters()) {
-      const std::string name = "adam." + depth_prefix(net.config().depth) + p.key();
-      if (!record.has(name + ".exp_avg") && !record.has(name + ".exp_avg_sq") && !record.has(name + ".step")) continue;
+      const std::string name = fields::adam_prefix + fields::depth_prefix(net.config().depth) + p.key();
+      if (!record.has(name + fields::per_parameter::exp_avg) && !record.has(name + fields::per_parameter::exp_avg_sq) &&
+          !record.has(name + fields::per_parameter::step))
+        continue;
       const auto as_tensor = [](const stream::Field& f) {
         return torch::from_blob(const_cast<uint8_t*>(f.bytes()), f.shape(), torch::kFloat32).clone();
       };
       AdamParamState state;
-      state.exp_avg(as_tensor(checked_field(name + ".exp_avg", p.value())));
-      state.exp_avg_sq(as_tensor(checked_field(name + ".exp_avg_sq", p.value())));
-      if (record.has(name + ".max_exp_avg_sq"))
-        state.max_exp_avg_sq(as_tensor(checked_field(name + ".max_exp_avg_sq", p.value())));
-      if (!record.has(name + ".step")) refuse(name + ".step is missing");
-      state.step(record.scalar<int64_t>(name + ".step"));
-      known.insert(name + ".step");
+      state.exp_avg(as_tensor(checked_field(name + fields::per_parameter::exp_avg, p.value())));
+      state.exp_avg_sq(as_tensor(checked_field(name + fields::per_parameter::exp_avg_sq, p.value())));
+      if (record.has(name + fields::per_parameter::max_exp_avg_sq))
+        state.max_exp_avg_sq(as_tensor(checked_field(name + fields::per_parameter::max_exp_avg_sq, p.value())));
+      if (!record.has(name + fields::per_parameter::step)) refuse(name + ".step is missing");
+      state.step(record.scalar<int64_t>(name + fields::per_parameter::step));
+      known.insert(name + fields::per_parameter::step);
       if (adam != nullptr && !optimised.count(adam_key(p.value())))
-        throw Error("load_checkpoint: the optimiser does not hold parameter " + depth_prefix(net.config().depth) +
-                    p.key());
+        throw Error("load_checkpoint: the optimiser does not hold parameter " +
+                    fields::depth_prefix(net.config().depth) + p.key());
       adam_states.emplace(adam_key(p.value()), std::move(state));
     }
   }

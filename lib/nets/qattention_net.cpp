@@ -174,15 +174,16 @@ void seed_torch(uint64_t seed) { torch::manual_seed(seed); }
 
 
 cli::OptionSpec torch_threads_option(int default_threads) {
-  return {"threads", "N",
-          "LibTorch threads; with more than 1 the program sets OMP_WAIT_POLICY=PASSIVE for itself unless it is set "
-          "(OpenMP threads that spin while they wait make a forward about 50 times slower when another busy process "
-          "shares the cores), at the price of a second start (~0.4 s). Outputs are the same bytes for the same "
-          "--threads; another count sums in another order, so values may differ in their last bit (measured: the "
-          "same voxels in 19 of 19 actions, 3 Q values 1e-7 apart). The networks' layers run in oneDNN directly where "
-          "the processor has AVX2 or wider; the environment variable QTE_NETWORK_LAYERS=libtorch runs LibTorch's layers "
-          "instead (values equal within fp32 rounding, other bytes)",
-          cli::default_text(default_threads)};
+  return cli::integer_option(
+      "threads", "N",
+      "LibTorch threads; with more than 1 the program sets OMP_WAIT_POLICY=PASSIVE for itself unless it is set "
+      "(OpenMP threads that spin while they wait make a forward about 50 times slower when another busy process "
+      "shares the cores), at the price of a second start (~0.4 s). Outputs are the same bytes for the same "
+      "--threads; another count sums in another order, so values may differ in their last bit (measured: the "
+      "same voxels in 19 of 19 actions, 3 Q values 1e-7 apart). The networks' layers run in oneDNN directly where "
+      "the processor has AVX2 or wider; the environment variable QTE_NETWORK_LAYERS=libtorch runs LibTorch's layers "
+      "instead (values equal within fp32 rounding, other bytes)",
+      cli::default_text(default_threads), 1, 256);
 }
 
 cli::OptionSpec precision_option() {

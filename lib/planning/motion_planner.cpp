@@ -1,7 +1,7 @@
 #include "planning/motion_planner.hpp"
 
-#include <ompl/base/spaces/RealVectorStateSpace.h>
 #include <ompl/base/samplers/UniformValidStateSampler.h>
+#include <ompl/base/spaces/RealVectorStateSpace.h>
 #include <ompl/geometric/SimpleSetup.h>
 #include <ompl/geometric/planners/rrt/RRTConnect.h>
 #include <ompl/util/Console.h>
@@ -12,6 +12,7 @@
 #include "common/random.hpp"
 #include "planning/time_parametrization.hpp"
 #include "robot/pose_values.hpp"
+#include "stream/field_names.hpp"
 
 namespace qte::planning {
 namespace ob = ompl::base;
@@ -64,26 +65,27 @@ robot::JointVector to_joints(const ob::State* state) {
 
 StartState start_state_from(const stream::Record& obs) {
   StartState start;
-  const auto q = obs.array<double>("joint_positions");
-  if (q.size() != robot::kArmJoints) obs.fail("joint_positions", "7 joint positions");
+  const auto q = obs.array<double>(fields::joint_positions);
+  if (q.size() != robot::kArmJoints) obs.fail(fields::joint_positions, "7 joint positions");
   for (int k = 0; k < robot::kArmJoints; ++k) {
-    if (!std::isfinite(q[k])) obs.fail("joint_positions", "finite values");
+    if (!std::isfinite(q[k])) obs.fail(fields::joint_positions, "finite values");
     start.joints[k] = q[k];
   }
-  start.opening_m = obs.scalar<double>("gripper_opening_m");
-  start.holding = obs.scalar<uint8_t>("gripper_open") == 0 && start.opening_m > 0.002;
+  start.opening_m = obs.scalar<double>(fields::gripper_opening_m);
+  start.holding = obs.scalar<uint8_t>(fields::gripper_open) == 0 && start.opening_m > 0.002;
   return start;
 }
 
 Goal goal_from(const stream::Record& action) {
-  const auto pose = action.array<double>("pose");
-  if (pose.size() != robot::kPoseValues) action.fail("pose", "float64 [7]: x, y, z, qx, qy, qz, qw");
+  const auto pose = action.array<double>(fields::pose);
+  if (pose.size() != robot::kPoseValues) action.fail(fields::pose, "float64 [7]: x, y, z, qx, qy, qz, qw");
   Goal goal;
   goal.tcp_pose.translation() << pose[0], pose[1], pose[2];
   goal.pose_valid = robot::pose_values_valid(pose.data);
   if (goal.pose_valid) goal.tcp_pose = robot::pose_from_values(pose.data);
-  goal.gripper_open = action.has("gripper_open") ? action.scalar<uint8_t>("gripper_open") != 0 : true;
-  goal.ignore_collisions = action.has("ignore_collisions") && action.scalar<uint8_t>("ignore_collisions") != 0;
+  goal.gripper_open = action.has(fields::gripper_open) ? action.scalar<uint8_t>(fields::gripper_open) != 0 : true;
+  goal.ignore_collisions =
+      action.has(fields::ignore_collisions) && action.scalar<uint8_t>(fields::ignore_collisions) != 0;
   return goal;
 }
 
@@ -98,7 +100,7 @@ MotionPlanner::MotionPlanner(const robot::RobotModel& robot, const Eigen::Isomet
 }
 
 OccupancyScene MotionPlanner::scene_from(const stream::Record& obs, const StartState& start, const Goal* goal) const {
-  const auto cameras = obs.prefixes(".points");
+  const auto cameras = obs.prefixes(fields::per_camera::points);
   if (cameras.empty())
     throw StreamError(obs.position, "'obs' record has no point cloud: plan-path needs <camera>.points "
                                     "(sim-step without --no-points)");
@@ -112,12 +114,14 @@ OccupancyScene MotionPlanner::scene_from(const stream::Record& obs, const StartS
     free_regions.push_back({goal->tcp_pose.translation(), options_.goal_free_radius_m, -1});
   OccupancyScene scene(options_.scene);
   for (const auto& camera : cameras) {
-    const auto points = obs.array<float>(camera + ".points");
-    const auto extrinsics = obs.array<double>(camera + ".extrinsics");
-    if (extrinsics.size() != 16) obs.fail(camera + ".extrinsics", "float64 [4, 4]");
+    const auto points = obs.array<float>(camera + fields::per_camera::points);
+    const auto extrinsics = obs.array<double>(camera + fields::per_camera::extrinsics);
+    if (extrinsics.size() != 16) obs.fail(camera + fields::per_camera::extrinsics, "float64 [4, 4]");
     for (std::size_t i = 0; i < 16; ++i)
-      if (!std::isfinite(extrinsics[i])) obs.fail(camera + ".extrinsics", "finite float64 [4, 4] (the camera pose)");
-    if (points.shape.size() != 3 || points.shape[2] != 3) obs.fail(camera + ".points", "float32 [H, W, 3]");
+      if (!std::isfinite(extrinsics[i]))
+        obs.fail(camera + fields::per_camera::extrinsics, "finite float64 [4, 4] (the camera pose)");
+    if (points.shape.size() != 3 || points.shape[2] != 3)
+      obs.fail(camera + fields::per_camera::points, "float32 [H, W, 3]");
     const Eigen::Vector3d origin(extrinsics[3], extrinsics[7], extrinsics[11]);
     scene.insert_camera(points.data, static_cast<std::size_t>(points.size() / 3), origin, robot_now, free_regions);
   }
@@ -305,9 +309,9 @@ std::vector<robot::JointVector> MotionPlanner::rrt_connect(const StartState& sta
 
 stream::Record action_record(const Goal& goal) {
   stream::Record action("action");
-  action.set<double>("pose", {robot::kPoseValues}, robot::pose_values(goal.tcp_pose));
-  action.set_scalar<uint8_t>("gripper_open", goal.gripper_open);
-  action.set_scalar<uint8_t>("ignore_collisions", goal.ignore_collisions);
+  action.set<double>(fields::pose, {robot::kPoseValues}, robot::pose_values(goal.tcp_pose));
+  action.set_scalar<uint8_t>(fields::gripper_open, goal.gripper_open);
+  action.set_scalar<uint8_t>(fields::ignore_collisions, goal.ignore_collisions);
   return action;
 }
 
@@ -335,17 +339,17 @@ void PlanPathFilter::handle(const stream::Record& record, const stream::Emit& em
 stream::Record trajectory_record(const PlanResult& plan, const Goal& goal) {
   stream::Record t("trajectory");
   if (!plan.failure.empty()) {
-    t.set_string("failure", plan.failure);
+    t.set_string(fields::failure, plan.failure);
   } else {
     const int64_t n = static_cast<int64_t>(plan.time_s.size());
     std::vector<double> joints;
     for (const auto& q : plan.joint_positions) joints.insert(joints.end(), q.data(), q.data() + robot::kArmJoints);
-    t.set<double>("time_s", {n}, plan.time_s);
-    t.set<double>("joint_positions", {n, robot::kArmJoints}, joints);
-    t.set_scalar<uint8_t>("gripper_open", goal.gripper_open);
-    t.set_string("method", plan.method);
+    t.set<double>(fields::time_s, {n}, plan.time_s);
+    t.set<double>(fields::joint_positions, {n, robot::kArmJoints}, joints);
+    t.set_scalar<uint8_t>(fields::gripper_open, goal.gripper_open);
+    t.set_string(fields::method, plan.method);
   }
-  t.set_scalar<uint8_t>("ignore_collisions", goal.ignore_collisions);
+  t.set_scalar<uint8_t>(fields::ignore_collisions, goal.ignore_collisions);
   return t;
 }
 

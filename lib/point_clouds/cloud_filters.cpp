@@ -1,8 +1,8 @@
 #include "point_clouds/cloud_filters.hpp"
 
+#include <pcl/common/common.h>
 #include <pcl/filters/crop_box.h>
 #include <pcl/filters/statistical_outlier_removal.h>
-#include <pcl/common/common.h>
 #include <pcl/filters/voxel_grid.h>
 #include <pcl/point_types.h>
 
@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "common/error.hpp"
+#include "stream/field_names.hpp"
 
 namespace qte::point_clouds {
 
@@ -22,8 +23,10 @@ std::vector<cli::OptionSpec> cloud_filter_options() {
        "point-cloud filter: drop points whose mean distance to their K nearest neighbours is more than S "
        "standard deviations above the cloud's mean (PCL's statistical outlier removal; e.g. 20,2)",
        ""},
-      {"downsample", "M", "point-cloud filter: replace the points in each M-metre cube by their centroid and mean "
-                          "colour (PCL's voxel grid)", ""},
+      cli::real_option("downsample", "M",
+                       "point-cloud filter: replace the points in each M-metre cube by their centroid and mean "
+                       "colour (PCL's voxel grid)",
+                       "", 1e-4, 1.0),
   };
 }
 
@@ -44,7 +47,7 @@ CloudFilters parse_cloud_filters(const cli::Arguments& args) {
     f.outlier_neighbours = static_cast<int>(v[0]);
     f.outlier_stddevs = v[1];
   }
-  if (args.has("downsample")) f.downsample_m = args.real("downsample", 1e-4, 1.0);
+  if (args.has("downsample")) f.downsample_m = args.real("downsample");
   return f;
 }
 
@@ -128,10 +131,10 @@ stream::Record filter_observation(const stream::Record& obs, const CloudFilters&
   for (const voxels::CameraCloud& camera : voxels::camera_clouds(obs)) {
     const voxels::ObservationCloud kept = filter_cloud(camera.cloud, filters);
     const int64_t m = static_cast<int64_t>(kept.rgb.size() / 3);
-    out.set<float>(camera.camera + ".points", {1, m, 3}, kept.xyz);
-    out.set<uint8_t>(camera.camera + ".rgb", {1, m, 3}, kept.rgb);
-    out.remove(camera.camera + ".depth");
-    out.remove(camera.camera + ".depth_mm");
+    out.set<float>(camera.camera + fields::per_camera::points, {1, m, 3}, kept.xyz);
+    out.set<uint8_t>(camera.camera + fields::per_camera::rgb, {1, m, 3}, kept.rgb);
+    out.remove(camera.camera + fields::per_camera::depth);
+    out.remove(camera.camera + fields::per_camera::depth_mm);
   }
   return out;
 }

@@ -8,9 +8,12 @@ namespace qte::qattention {
 
 std::vector<cli::OptionSpec> branching_options() {
   return {
-      {"k-margin", "M", "with K 'auto': expand every voxel whose Q is within M of the node's best", ""},
-      {"k-mass", "P", "with K 'auto': expand the fewest best voxels holding P (0 < P <= 1) of the node's softmax", ""},
-      {"k-max", "N", "with K 'auto': expand at most N voxels per node", "10"},
+      cli::real_option("k-margin", "M", "with K 'auto': expand every voxel whose Q is within M of the node's best", "",
+                       0, 1e30),
+      cli::real_option("k-mass", "P",
+                       "with K 'auto': expand the fewest best voxels holding P (0 < P <= 1) of the node's softmax", "",
+                       1e-9, 1),
+      cli::integer_option("k-max", "N", "with K 'auto': expand at most N voxels per node", "10", 1, 4096),
   };
 }
 
@@ -22,12 +25,12 @@ Branching parse_branching(const cli::Arguments& args, const std::string& k_optio
     return Branching(static_cast<int>(args.integer(k_option, min_k, 4096)));
   }
   if (margin == mass) throw UsageError("--" + k_option + " auto needs one of --k-margin and --k-mass");
-  const int k_max = static_cast<int>(args.integer("k-max", 1, 4096));
+  const int k_max = static_cast<int>(args.integer("k-max"));
   if (margin) {
-    const double m = args.real("k-margin", 0, 1e30);
+    const double m = args.real("k-margin");
     return Branching::within_margin(static_cast<float>(m), k_max);
   }
-  const double p = args.real("k-mass", 1e-9, 1);
+  const double p = args.real("k-mass");
   return Branching::softmax_mass(static_cast<float>(p), k_max);
 }
 

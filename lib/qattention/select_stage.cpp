@@ -8,6 +8,7 @@
 #include "common/random.hpp"
 #include "qattention/action_record.hpp"
 #include "qattention/proprio.hpp"
+#include "stream/field_names.hpp"
 #include "voxels/observation_cloud.hpp"
 
 namespace qte::qattention {
@@ -19,7 +20,7 @@ SelectStage::SelectStage(CheckpointNetworks& networks, SelectOptions options)
 Action SelectStage::act_on(const stream::Record& obs, const voxels::ObservationCloud& observed, int32_t step) {
   const std::vector<float> proprio = proprio_of(obs, step);
   for (float p : proprio)
-    if (!std::isfinite(p)) obs.fail("gripper_opening_m", "a finite gripper opening");
+    if (!std::isfinite(p)) obs.fail(fields::gripper_opening_m, "a finite gripper opening");
   std::mt19937_64 rng(derive_seed(options_.seed, actions_));
   try {
     return act(evaluate_, options_.hierarchy, observed.view(), proprio, options_.branching, options_.exploration, rng);
@@ -33,8 +34,8 @@ Action SelectStage::act_on(const stream::Record& obs, const voxels::ObservationC
 void SelectStage::handle(const stream::Record& record, const stream::Emit& emit) {
   emit(record);
   if (record.type() != "obs") return;
-  if (record.has("terminal") && record.scalar<uint8_t>("terminal") != 0) return;
-  const int32_t step = record.scalar<int32_t>("step");
+  if (record.has(fields::terminal) && record.scalar<uint8_t>(fields::terminal) != 0) return;
+  const int32_t step = record.scalar<int32_t>(fields::step);
   if (options_.reload && step == 0 && networks_.reload_if_changed())
     std::cerr << "qte-select: loaded checkpoint " << networks_.path() << " at training step " << networks_.step()
               << std::endl;

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "common/error.hpp"
+#include "stream/field_names.hpp"
 
 namespace qte::replay {
 namespace {
@@ -20,17 +21,17 @@ ReplayBuffer::ReplayBuffer(ReplayOptions options) : options_(options), tree_(opt
 
 bool ReplayBuffer::add(const stream::Record& record) {
   if (record.type() == "frame") {
-    const FrameKey key{record.scalar<int64_t>("episode_key"), record.scalar<int32_t>("frame")};
+    const FrameKey key{record.scalar<int64_t>(fields::episode_key), record.scalar<int32_t>(fields::frame)};
     auto it = frames_.find(key);
     if (it == frames_.end()) frames_.emplace(key, std::make_pair(record, 0));
     return true;
   }
   if (record.type() != "transition") return false;
   Stored stored{record,
-                {record.scalar<int64_t>("episode_key"), record.scalar<int32_t>("frame")},
-                {record.scalar<int64_t>("episode_key"), record.scalar<int32_t>("next_frame")},
-                record.has("step") ? record.scalar<int32_t>("step") : 0,
-                record.has("demo") && record.scalar<uint8_t>("demo") != 0};
+                {record.scalar<int64_t>(fields::episode_key), record.scalar<int32_t>(fields::frame)},
+                {record.scalar<int64_t>(fields::episode_key), record.scalar<int32_t>(fields::next_frame)},
+                record.has(fields::step) ? record.scalar<int32_t>(fields::step) : 0,
+                record.has(fields::demo) && record.scalar<uint8_t>(fields::demo) != 0};
   for (const FrameKey* key : {&stored.frame, &stored.next_frame})
     if (!frames_.count(*key))
       throw StreamError(record.position, "transition refers to frame " + std::to_string(key->second) +

@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include "report/csv.hpp"
+#include "stream/field_names.hpp"
 #include "stream/reader.hpp"
 #include "stream/stage.hpp"
 
@@ -29,23 +30,23 @@ void EpisodeSplitter::report_unfinished(const std::string& where) {
 
 void EpisodeSplitter::handle(const stream::Record& obs) {
   if (obs.type() != "obs") return;
-  if (observations_ > 0 && obs.has("frame") && obs.scalar<int32_t>("frame") == 0) {
+  if (observations_ > 0 && obs.has(fields::frame) && obs.scalar<int32_t>(fields::frame) == 0) {
     report_unfinished("before record " + std::to_string(obs.position.record_index));
     observations_ = 0;
     return_so_far_ = 0;
   }
   ++observations_;
-  const float reward = obs.scalar<float>("reward");
-  if (!std::isfinite(reward)) obs.fail("reward", "a finite reward");
+  const float reward = obs.scalar<float>(fields::reward);
+  if (!std::isfinite(reward)) obs.fail(fields::reward, "a finite reward");
   return_so_far_ += reward;
-  if (obs.scalar<uint8_t>("terminal") == 0) return;
+  if (obs.scalar<uint8_t>(fields::terminal) == 0) return;
   Episode e;
-  e.seed = obs.has("episode_seed") ? obs.scalar<int64_t>("episode_seed") : 0;
-  e.task = optional_string(obs, "task");
-  e.success = obs.scalar<uint8_t>("success") != 0;
-  e.steps = obs.scalar<int32_t>("step");
+  e.seed = obs.has(fields::episode_seed) ? obs.scalar<int64_t>(fields::episode_seed) : 0;
+  e.task = optional_string(obs, fields::task);
+  e.success = obs.scalar<uint8_t>(fields::success) != 0;
+  e.steps = obs.scalar<int32_t>(fields::step);
   e.return_ = return_so_far_;
-  e.failure = optional_string(obs, "failure");
+  e.failure = optional_string(obs, fields::failure);
   episodes_.push_back(std::move(e));
   observations_ = 0;
   return_so_far_ = 0;

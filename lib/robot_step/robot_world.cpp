@@ -10,6 +10,7 @@
 #include "observation/observation.hpp"
 #include "planning/collision_checker.hpp"
 #include "robot/joint_path.hpp"
+#include "stream/field_names.hpp"
 #include "tasks/task.hpp"
 #include "world/scene_layout.hpp"
 
@@ -140,7 +141,8 @@ stream::Record RobotWorld::observe() {
                                        camera_recordings::read_depth_png(frame.depth_png),
                                        frame.colour_png + " and " + frame.depth_png);
   if (options_.compress)
-    for (const char* name : {".rgb", ".depth_mm", ".depth", ".points"})
+    for (const char* name :
+         {fields::per_camera::rgb, fields::per_camera::depth_mm, fields::per_camera::depth, fields::per_camera::points})
       if (const stream::Field* f = obs.find(options_.camera.name + name)) {
         stream::Field compressed = *f;
         compressed.compress = true;
@@ -174,9 +176,9 @@ void RobotWorld::set_episode_fields(stream::Record& obs, const std::string& fail
 }
 
 void RobotWorld::reset(const stream::Record& record, const stream::Emit& emit) {
-  episode_.task = record.has("task") ? record.string("task") : "real";
-  episode_.variation = record.has("variation") ? record.scalar<int32_t>("variation") : 0;
-  episode_.seed = record.has("seed") ? record.scalar<int64_t>("seed") : 0;
+  episode_.task = record.has(fields::task) ? record.string(fields::task) : "real";
+  episode_.variation = record.has(fields::variation) ? record.scalar<int32_t>(fields::variation) : 0;
+  episode_.seed = record.has(fields::seed) ? record.scalar<int64_t>(fields::seed) : 0;
   episode_.episode = episodes_++;
   description_.clear();  // a simulated task's words, when the real scene is named after one
   const std::vector<std::string> known = tasks::task_names();
@@ -212,7 +214,7 @@ void RobotWorld::reset(const stream::Record& record, const stream::Emit& emit) {
 }
 
 std::string RobotWorld::check_motion(const stream::Record& record, std::vector<robot::XarmRow>& rows) const {
-  if (record.has("failure")) return record.string("failure");  // the planner found no path
+  if (record.has(fields::failure)) return record.string(fields::failure);  // the planner found no path
   const sim_step::TrajectoryWaypoints path = sim_step::trajectory_waypoints(record);
   robot::JointPathLimits limits;
   limits.start = &joints_;
@@ -222,9 +224,9 @@ std::string RobotWorld::check_motion(const stream::Record& record, std::vector<r
   std::vector<double> stretched(path.time_s, path.time_s + path.n);
   const double stretch = time_stretch(path.time_s, path.joints, path.n, robot_, options_.speed_fraction);
   for (double& t : stretched) t *= stretch;
-  const double after_m = !record.has("gripper_open") ? gripper_m_
-                         : record.scalar<uint8_t>("gripper_open") ? robot_.max_finger_opening_m()
-                                                                  : 0.0;
+  const double after_m = !record.has(fields::gripper_open)              ? gripper_m_
+                         : record.scalar<uint8_t>(fields::gripper_open) ? robot_.max_finger_opening_m()
+                                                                        : 0.0;
   try {
     rows = robot::xarm_rows(stretched.data(), path.joints, path.n, gripper_m_, after_m, robot_, options_.timing.rate_hz,
                             options_.timing.settle_s);
@@ -253,7 +255,7 @@ void RobotWorld::execute(const stream::Record& record, const stream::Emit& emit)
   if (!started_) throw StreamError(record.position, "trajectory before any reset: expected a reset record first");
   if (terminal_) throw StreamError(record.position, "trajectory after the episode ended: expected a reset record");
   step_ += 1;
-  ignore_collisions_ = record.has("ignore_collisions") && record.scalar<uint8_t>("ignore_collisions") != 0;
+  ignore_collisions_ = record.has(fields::ignore_collisions) && record.scalar<uint8_t>(fields::ignore_collisions) != 0;
   std::vector<robot::XarmRow> rows;
   std::string failure = check_motion(record, rows);
   if (failure.empty()) {

@@ -14,6 +14,7 @@
 #include "observation/observation.hpp"
 #include "robot/joint_path.hpp"
 #include "robot/pose_values.hpp"
+#include "stream/field_names.hpp"
 
 namespace qte::sim_step {
 namespace {
@@ -72,9 +73,9 @@ stream::Record Simulator::observe(const std::string& failure) {
     const int64_t h = frame.rgb.rows, w = frame.rgb.cols;
     const std::string& n = camera.name;
     const bool z = options_.compress_images;
-    obs.set<uint8_t>(n + ".rgb", {h, w, 3}, frame.rgb.ptr<uint8_t>(), z);
-    obs.set<float>(n + ".depth", {h, w}, frame.depth.ptr<float>(), z);
-    if (options_.point_clouds) obs.set<float>(n + ".points", {h, w, 3}, frame.points.ptr<float>(), z);
+    obs.set<uint8_t>(n + fields::per_camera::rgb, {h, w, 3}, frame.rgb.ptr<uint8_t>(), z);
+    obs.set<float>(n + fields::per_camera::depth, {h, w}, frame.depth.ptr<float>(), z);
+    if (options_.point_clouds) obs.set<float>(n + fields::per_camera::points, {h, w, 3}, frame.points.ptr<float>(), z);
     observation::set_camera_pose(obs, n, frame.intrinsics, frame.world_from_camera);
   }
   observation::ArmState arm;
@@ -118,11 +119,11 @@ void set_object_fields(stream::Record& obs, const world::World& world) {
     const Eigen::AlignedBox3d box = world.object_box(id);
     for (const Eigen::Vector3d& corner : {box.min(), box.max()}) boxes.insert(boxes.end(), corner.data(), corner.data() + 3);
   }
-  obs.set_string("objects.names", names);
-  obs.set<uint8_t>("objects.role", {n}, roles);
-  obs.set<double>("objects.pose", {n, robot::kPoseValues}, poses);
-  obs.set<double>("objects.box", {n, 6}, boxes);
-  obs.set<uint8_t>("objects.held", {n}, held);
+  obs.set_string(fields::objects_names, names);
+  obs.set<uint8_t>(fields::objects_role, {n}, roles);
+  obs.set<double>(fields::objects_pose, {n, robot::kPoseValues}, poses);
+  obs.set<double>(fields::objects_box, {n, 6}, boxes);
+  obs.set<uint8_t>(fields::objects_held, {n}, held);
 }
 
 void Simulator::handle(const stream::Record& record, const stream::Emit& emit) {
@@ -131,19 +132,19 @@ void Simulator::handle(const stream::Record& record, const stream::Emit& emit) {
 }
 
 void Simulator::reset(const stream::Record& record, const stream::Emit& emit) {
-  task_name_ = record.string("task");
+  task_name_ = record.string(fields::task);
   try {
     task_ = tasks::make_task(task_name_);
   } catch (const StreamError&) {
     throw;
   } catch (const Error& e) {
-    record.fail("task", std::string("a known task: ") + e.what());
+    record.fail(fields::task, std::string("a known task: ") + e.what());
   }
-  variation_ = record.has("variation") ? record.scalar<int32_t>("variation") : 0;
+  variation_ = record.has(fields::variation) ? record.scalar<int32_t>(fields::variation) : 0;
   if (variation_ < 0 || variation_ >= task_->variation_count())
-    record.fail("variation", "0 to " + std::to_string(task_->variation_count() - 1) + " for " +
-                                 task_name_ + ", got " + std::to_string(variation_));
-  episode_seed_ = record.has("seed") ? record.scalar<int64_t>("seed") : 0;
+    record.fail(fields::variation, "0 to " + std::to_string(task_->variation_count() - 1) + " for " + task_name_ +
+                                       ", got " + std::to_string(variation_));
+  episode_seed_ = record.has(fields::seed) ? record.scalar<int64_t>(fields::seed) : 0;
   world_ = std::make_unique<world::World>(robot_);
   std::mt19937_64 rng(static_cast<uint64_t>(episode_seed_));
   try {
@@ -161,17 +162,18 @@ void Simulator::reset(const stream::Record& record, const stream::Emit& emit) {
 }
 
 TrajectoryWaypoints trajectory_waypoints(const stream::Record& trajectory) {
-  const auto times = trajectory.array<double>("time_s");
-  const auto joints = trajectory.array<double>("joint_positions");
+  const auto times = trajectory.array<double>(fields::time_s);
+  const auto joints = trajectory.array<double>(fields::joint_positions);
   const int64_t n = times.size();
   if (n < 1 || joints.shape != stream::Shape{n, robot::kArmJoints})
-    trajectory.fail("joint_positions", "float64 [N, 7] with N = " + std::to_string(n) +
-                                           " (the length of time_s), got " + stream::shape_to_string(joints.shape));
+    trajectory.fail(fields::joint_positions, "float64 [N, 7] with N = " + std::to_string(n) +
+                                                 " (the length of time_s), got " +
+                                                 stream::shape_to_string(joints.shape));
   return {times.data, joints.data, n};
 }
 
 std::string Simulator::check_trajectory(const stream::Record& record) const {
-  if (record.has("failure")) return record.string("failure");
+  if (record.has(fields::failure)) return record.string(fields::failure);
   const TrajectoryWaypoints path = trajectory_waypoints(record);
   robot::JointPathLimits limits;
   limits.max_duration_s = options_.max_trajectory_s;
@@ -186,11 +188,11 @@ void Simulator::execute(const stream::Record& record, const stream::Emit& emit) 
   if (terminal_)
     throw StreamError(record.position, "trajectory after the episode ended: expected a reset record");
   step_ += 1;
-  ignore_collisions_ = record.has("ignore_collisions") && record.scalar<uint8_t>("ignore_collisions") != 0;
+  ignore_collisions_ = record.has(fields::ignore_collisions) && record.scalar<uint8_t>(fields::ignore_collisions) != 0;
   std::string failure = check_trajectory(record);
   if (failure.empty()) {
-    const auto times = record.array<double>("time_s");
-    const auto joints = record.array<double>("joint_positions");
+    const auto times = record.array<double>(fields::time_s);
+    const auto joints = record.array<double>(fields::joint_positions);
     const int64_t n = times.size();
     // Sample the piecewise-linear trajectory at the control period; physics runs in between.
     const double duration = times[n - 1];
@@ -218,8 +220,8 @@ void Simulator::execute(const stream::Record& record, const stream::Emit& emit) 
       if (options_.observe_every_step && failure.empty() && s < control_steps) emit(observe());
     }
     velocity_.setZero();
-    if (failure.empty() && record.has("gripper_open")) {
-      const bool open = record.scalar<uint8_t>("gripper_open") != 0;
+    if (failure.empty() && record.has(fields::gripper_open)) {
+      const bool open = record.scalar<uint8_t>(fields::gripper_open) != 0;
       const bool is_open = world_->gripper_open();
       if (open && !is_open) {
         // Placing: a released object comes to rest before success is judged (stacks, checkers).
@@ -266,10 +268,10 @@ stream::Record plan_reset(const EpisodePlan& plan, int index) {
   if (variation < 0)  // not from the low bits: they name the scene set
     variation = static_cast<int>(derive_seed(seed, 0x7a) % tasks::make_task(plan.task)->variation_count());
   stream::Record reset("reset");
-  reset.set_string("task", plan.task);
-  reset.set_scalar<int32_t>("variation", variation);
-  reset.set_scalar<int64_t>("seed", static_cast<int64_t>(seed));
-  reset.set_scalar<int32_t>("episode", index);
+  reset.set_string(fields::task, plan.task);
+  reset.set_scalar<int32_t>(fields::variation, variation);
+  reset.set_scalar<int64_t>(fields::seed, static_cast<int64_t>(seed));
+  reset.set_scalar<int32_t>(fields::episode, index);
   return reset;
 }
 

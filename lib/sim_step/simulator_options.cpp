@@ -34,7 +34,7 @@ SimulatorOptions parse_camera_options(const cli::Arguments& args) {
 
 std::vector<cli::OptionSpec> episode_options(int default_episodes, SceneSet default_scenes) {
   return {
-      {"episodes", "N", "episodes to run", std::to_string(default_episodes)},
+      cli::integer_option("episodes", "N", "episodes to run", std::to_string(default_episodes), 1, 10000000),
       {"variation", "V", "task variation, or 'random' for one per episode", "0"},
       {"scenes", "SET", "the scene set episodes are drawn from: demo, explore, eval (disjoint for every --seed) or any",
        scene_set_name(default_scenes)},
@@ -45,7 +45,7 @@ EpisodePlan parse_episode_plan(const cli::Arguments& args, const std::string& ta
   const auto made = tasks::make_task(task);  // an unknown task fails before anything is written
   EpisodePlan plan;
   plan.task = task;
-  plan.episodes = static_cast<int>(args.integer("episodes", 1, 10000000));
+  plan.episodes = static_cast<int>(args.integer("episodes"));
   // The task's own range: a usage error naming the option, before any input is read.
   plan.variation = args.text("variation") == "random"
                        ? -1
@@ -57,12 +57,16 @@ EpisodePlan parse_episode_plan(const cli::Arguments& args, const std::string& ta
 
 std::vector<cli::OptionSpec> chunk_options() {
   return {
-      {"chunk-episodes", "N", "with --task: run episodes in chunks of N, chunk c drawn as --seed S + c "
-                              "would draw them (an actor that stays up for a whole learning run); needs --gate", "0"},
-      {"first-chunk", "C", "the first chunk this process runs", "0"},
-      {"chunk-stride", "S", "the chunks this process runs: C, C + S, C + 2S, ...", "1"},
-      {"gate", "DIR", "chunk c starts once DIR/cccc.go exists (c with at least four digits); none starts "
-                      "once DIR/stop exists; DIR/cccc.steps gets the environment steps of chunk c when it ends", ""},
+      cli::integer_option("chunk-episodes", "N",
+                          "with --task: run episodes in chunks of N, chunk c drawn as --seed S + c "
+                          "would draw them (an actor that stays up for a whole learning run); needs --gate",
+                          "0", 0, 10000000),
+      cli::integer_option("first-chunk", "C", "the first chunk this process runs", "0", 0, 100000000),
+      cli::integer_option("chunk-stride", "S", "the chunks this process runs: C, C + S, C + 2S, ...", "1", 1, 1000000),
+      {"gate", "DIR",
+       "chunk c starts once DIR/cccc.go exists (c with at least four digits); none starts "
+       "once DIR/stop exists; DIR/cccc.steps gets the environment steps of chunk c when it ends",
+       ""},
   };
 }
 
@@ -70,16 +74,15 @@ void run_episodes(const cli::Arguments& args, EpisodeStage& env, std::optional<E
   const std::string input = args.input();
   std::unique_ptr<stream::RecordReader> reader;
   stream::RecordWriter writer(args.text("output"));
-  const int chunk_episodes = static_cast<int>(args.integer("chunk-episodes", 0, 10000000));
+  const int chunk_episodes = static_cast<int>(args.integer("chunk-episodes"));
   if (chunk_episodes > 0 && (!plan || args.text("gate").empty()))
     throw UsageError("--chunk-episodes needs --task and --gate");
   DirectoryGate gate(args.text("gate"));
-  SimStep stage = chunk_episodes > 0
-                      ? SimStep(env, *plan,
-                                {chunk_episodes, static_cast<int>(args.integer("first-chunk", 0, 100000000)),
-                                 static_cast<int>(args.integer("chunk-stride", 1, 1000000))},
-                                gate)
-                      : SimStep(env, plan);
+  SimStep stage = chunk_episodes > 0 ? SimStep(env, *plan,
+                                               {chunk_episodes, static_cast<int>(args.integer("first-chunk")),
+                                                static_cast<int>(args.integer("chunk-stride"))},
+                                               gate)
+                                     : SimStep(env, plan);
   stream::run_stage(
       stage,
       [&]() -> std::optional<stream::Record> {

@@ -8,6 +8,7 @@
 
 #include "common/error.hpp"
 #include "common/indexed_name.hpp"
+#include "stream/field_names.hpp"
 
 namespace qte::video {
 
@@ -24,15 +25,18 @@ cv::Mat image_field(const stream::Record& record, const stream::Field& field, bo
 
 EpisodeVideo::EpisodeVideo(const std::string& path, double fps, const std::string& camera, std::string attention_dir,
                            int height)
-    : file_(path, fps), camera_(camera + ".rgb"), attention_dir_(std::move(attention_dir)), height_(height) {}
+    : file_(path, fps),
+      camera_(camera + fields::per_camera::rgb),
+      attention_dir_(std::move(attention_dir)),
+      height_(height) {}
 
 // qte-select acts on the last observation of each step: with sim-step --every-step the frames
 // during a motion share the step of the observation that ends it, so only the next
 // observation tells whether this one was acted on. Frames therefore go out one behind.
 void EpisodeVideo::add(const stream::Record& obs, bool shown) {
   Frame next{shown ? image_field(obs, obs.field(camera_), false).clone() : cv::Mat(),
-             obs.has("step") ? obs.scalar<int32_t>("step") : -1,
-             obs.has("terminal") && obs.scalar<uint8_t>("terminal") != 0, true};
+             obs.has(fields::step) ? obs.scalar<int32_t>(fields::step) : -1,
+             obs.has(fields::terminal) && obs.scalar<uint8_t>(fields::terminal) != 0, true};
   if (pending_.valid) write(pending_, next.step != pending_.step || pending_.step < 0);
   pending_ = std::move(next);
 }

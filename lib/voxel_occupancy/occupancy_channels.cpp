@@ -1,6 +1,7 @@
 #include "voxel_occupancy/occupancy_channels.hpp"
 
 #include "planning/occupancy_scene.hpp"
+#include "stream/field_names.hpp"
 #include "voxels/observation_cloud.hpp"
 
 namespace qte::voxel_occupancy {
@@ -16,10 +17,12 @@ ObservedSpace::ObservedSpace(const stream::Record& obs, double resolution_m) {
   planning::SceneOptions options;
   options.resolution_m = resolution_m;
   impl_ = std::make_unique<Impl>(options);
-  for (const std::string& camera : obs.prefixes(".extrinsics")) {
-    const std::string name = camera + ".extrinsics";
+  for (const std::string& camera : obs.prefixes(fields::per_camera::extrinsics)) {
+    const std::string name = camera + fields::per_camera::extrinsics;
     stream::Record one("obs");  // one camera at a time: its rays start at its own origin
-    for (const char* part : {".rgb", ".points", ".depth", ".depth_mm", ".intrinsics", ".extrinsics"})
+    for (const char* part :
+         {fields::per_camera::rgb, fields::per_camera::points, fields::per_camera::depth, fields::per_camera::depth_mm,
+          fields::per_camera::intrinsics, fields::per_camera::extrinsics})
       if (obs.has(camera + part)) one.add(obs.field(camera + part));
     one.position = obs.position;
     const ObservationCloud cloud = observation_cloud(one);

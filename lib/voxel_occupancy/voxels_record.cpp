@@ -3,10 +3,11 @@
 #include <cstdio>
 #include <memory>
 
-#include "voxels/grid_fields.hpp"
 #include "common/indexed_name.hpp"
-#include "voxels/observation_cloud.hpp"
+#include "stream/field_names.hpp"
 #include "voxel_occupancy/occupancy_channels.hpp"
+#include "voxels/grid_fields.hpp"
+#include "voxels/observation_cloud.hpp"
 #include "voxels/voxel_image.hpp"
 
 namespace qte::voxel_occupancy {
@@ -34,8 +35,9 @@ VoxelsOfObservation voxels_of(const stream::Record& obs, const VoxelsRecordOptio
     return append_channels(g, extra.data(), static_cast<int>(v), kOccupancyChannels);
   };
   const int64_t channels = kChannels + (space ? kOccupancyChannels : 0);
-  out.record.set<float>("depth0.grid", {v, v, v, channels}, with_channels(0, options.scene));
-  out.record.set<double>("depth0.bounds", {4}, bounds_values(options.scene));
+  out.record.set<float>(fields::depth_field(0, fields::per_depth::grid), {v, v, v, channels},
+                        with_channels(0, options.scene));
+  out.record.set<double>(fields::depth_field(0, fields::per_depth::bounds), {4}, bounds_values(options.scene));
   if (options.crops.empty()) return out;
   std::vector<float> grids;
   std::vector<double> bounds;
@@ -45,8 +47,8 @@ VoxelsOfObservation voxels_of(const stream::Record& obs, const VoxelsRecordOptio
     const std::vector<double> b = bounds_values(options.crops[c]);
     bounds.insert(bounds.end(), b.begin(), b.end());
   }
-  out.record.set<float>("depth1.grid", {k, v, v, v, channels}, grids);
-  out.record.set<double>("depth1.bounds", {k, 4}, bounds);
+  out.record.set<float>(fields::depth_field(1, fields::per_depth::grid), {k, v, v, v, channels}, grids);
+  out.record.set<double>(fields::depth_field(1, fields::per_depth::bounds), {k, 4}, bounds);
   return out;
 }
 

@@ -1,5 +1,7 @@
 #include "voxels/grid_fields.hpp"
 
+#include "stream/field_names.hpp"
+
 namespace qte::voxels {
 
 std::vector<double> bounds_values(const GridBounds& b) {
@@ -17,18 +19,18 @@ GridBounds bounds_field(const stream::Record& record, const std::string& name, i
 }
 
 void set_hierarchy(stream::Record& record, const CoarseToFine& h) {
-  record.set<double>("hierarchy.bounds", {4}, bounds_values(h.scene));
-  record.set<double>("hierarchy.offsets", {static_cast<int64_t>(h.offsets_m.size())}, h.offsets_m);
-  record.set_scalar<int32_t>("hierarchy.depths", h.depths);
-  record.set_scalar<int32_t>("hierarchy.voxels", h.voxels());
+  record.set<double>(fields::hierarchy_bounds, {4}, bounds_values(h.scene));
+  record.set<double>(fields::hierarchy_offsets, {static_cast<int64_t>(h.offsets_m.size())}, h.offsets_m);
+  record.set_scalar<int32_t>(fields::hierarchy_depths, h.depths);
+  record.set_scalar<int32_t>(fields::hierarchy_voxels, h.voxels());
 }
 
 std::optional<CoarseToFine> hierarchy_of(const stream::Record& record) {
-  if (!record.has("hierarchy.bounds")) return std::nullopt;
+  if (!record.has(fields::hierarchy_bounds)) return std::nullopt;
   CoarseToFine h;
-  h.depths = record.scalar<int32_t>("hierarchy.depths");
-  h.scene = bounds_field(record, "hierarchy.bounds", record.scalar<int32_t>("hierarchy.voxels"));
-  const auto offsets = record.array<double>("hierarchy.offsets");
+  h.depths = record.scalar<int32_t>(fields::hierarchy_depths);
+  h.scene = bounds_field(record, fields::hierarchy_bounds, record.scalar<int32_t>(fields::hierarchy_voxels));
+  const auto offsets = record.array<double>(fields::hierarchy_offsets);
   h.offsets_m.assign(offsets.begin(), offsets.end());
   return h;
 }

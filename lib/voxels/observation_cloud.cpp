@@ -6,6 +6,8 @@
 #include <limits>
 #include <tuple>
 
+#include "stream/field_names.hpp"
+
 namespace qte::voxels {
 
 std::vector<uint16_t> depth_in_mm(const float* depth_m, std::size_t count) {
@@ -57,16 +59,16 @@ std::string extrinsics_problem(const double* e) {
 }
 
 void check_camera_matrices(const stream::Record& obs, const std::string& camera) {
-  if (obs.has(camera + ".intrinsics")) {
-    const auto k = obs.array<double>(camera + ".intrinsics");
-    if (k.size() != 9) obs.fail(camera + ".intrinsics", "float64 [3, 3]");
+  if (obs.has(camera + fields::per_camera::intrinsics)) {
+    const auto k = obs.array<double>(camera + fields::per_camera::intrinsics);
+    if (k.size() != 9) obs.fail(camera + fields::per_camera::intrinsics, "float64 [3, 3]");
     const std::string problem = intrinsics_problem(k.data);
-    if (!problem.empty()) obs.fail(camera + ".intrinsics", problem);
+    if (!problem.empty()) obs.fail(camera + fields::per_camera::intrinsics, problem);
   }
-  const auto e = obs.array<double>(camera + ".extrinsics");
-  if (e.size() != 16) obs.fail(camera + ".extrinsics", "float64 [4, 4]");
+  const auto e = obs.array<double>(camera + fields::per_camera::extrinsics);
+  if (e.size() != 16) obs.fail(camera + fields::per_camera::extrinsics, "float64 [4, 4]");
   const std::string problem = extrinsics_problem(e.data);
-  if (!problem.empty()) obs.fail(camera + ".extrinsics", problem);
+  if (!problem.empty()) obs.fail(camera + fields::per_camera::extrinsics, problem);
 }
 
 std::size_t points_inside(const PointCloud& cloud, const GridBounds& bounds) {
@@ -99,7 +101,7 @@ namespace {
 // Returns the image's (height, width).
 std::pair<int, int> append_camera(const stream::Record& obs, const std::string& camera, std::vector<float>& xyz,
                                   std::vector<uint8_t>& rgb_out) {
-  const std::string name = camera + ".rgb";
+  const std::string name = camera + fields::per_camera::rgb;
   const auto rgb = obs.array<uint8_t>(name);
   if (rgb.shape.size() != 3 || rgb.shape[2] != 3) obs.fail(name, "uint8 [H, W, 3]");
   const int h = static_cast<int>(rgb.shape[0]), w = static_cast<int>(rgb.shape[1]);
@@ -107,27 +109,29 @@ std::pair<int, int> append_camera(const stream::Record& obs, const std::string& 
   rgb_out.insert(rgb_out.end(), rgb.begin(), rgb.end());
   xyz.resize(3 * (at + n));
   float* out = xyz.data() + 3 * at;
-  if (obs.has(camera + ".extrinsics")) check_camera_matrices(obs, camera);
-  if (obs.has(camera + ".points")) {
-    const auto points = obs.array<float>(camera + ".points");
-    if (points.shape != stream::Shape{h, w, 3}) obs.fail(camera + ".points", "float32 [H, W, 3] like " + name);
+  if (obs.has(camera + fields::per_camera::extrinsics)) check_camera_matrices(obs, camera);
+  if (obs.has(camera + fields::per_camera::points)) {
+    const auto points = obs.array<float>(camera + fields::per_camera::points);
+    if (points.shape != stream::Shape{h, w, 3})
+      obs.fail(camera + fields::per_camera::points, "float32 [H, W, 3] like " + name);
     std::copy(points.begin(), points.end(), out);
     return {h, w};
   }
   std::vector<float> depth(n);
-  if (obs.has(camera + ".depth_mm")) {
-    const auto mm = obs.array<uint16_t>(camera + ".depth_mm");
-    if (mm.shape != stream::Shape{h, w}) obs.fail(camera + ".depth_mm", "uint16 [H, W] like " + name);
+  if (obs.has(camera + fields::per_camera::depth_mm)) {
+    const auto mm = obs.array<uint16_t>(camera + fields::per_camera::depth_mm);
+    if (mm.shape != stream::Shape{h, w}) obs.fail(camera + fields::per_camera::depth_mm, "uint16 [H, W] like " + name);
     for (std::size_t i = 0; i < n; ++i) depth[i] = mm[i] * 0.001f;
   } else {
-    const auto d = obs.array<float>(camera + ".depth");
-    if (d.shape != stream::Shape{h, w}) obs.fail(camera + ".depth", "float32 [H, W] like " + name);
+    const auto d = obs.array<float>(camera + fields::per_camera::depth);
+    if (d.shape != stream::Shape{h, w}) obs.fail(camera + fields::per_camera::depth, "float32 [H, W] like " + name);
     std::copy(d.begin(), d.end(), depth.begin());
   }
   check_camera_matrices(obs, camera);  // depth needs both
-  if (!obs.has(camera + ".intrinsics")) obs.fail(camera + ".intrinsics", "float64 [3, 3] (depth needs it)");
-  const auto k = obs.array<double>(camera + ".intrinsics");
-  const auto e = obs.array<double>(camera + ".extrinsics");
+  if (!obs.has(camera + fields::per_camera::intrinsics))
+    obs.fail(camera + fields::per_camera::intrinsics, "float64 [3, 3] (depth needs it)");
+  const auto k = obs.array<double>(camera + fields::per_camera::intrinsics);
+  const auto e = obs.array<double>(camera + fields::per_camera::extrinsics);
   points_from_depth(depth.data(), w, h, k.data, e.data, out);
   return {h, w};
 }
@@ -141,7 +145,7 @@ std::pair<int, int> append_camera(const stream::Record& obs, const std::string& 
 
 ObservationCloud observation_cloud(const stream::Record& obs) {
   ObservationCloud cloud;
-  const std::vector<std::string> cameras = obs.prefixes(".rgb");
+  const std::vector<std::string> cameras = obs.prefixes(fields::per_camera::rgb);
   if (cameras.empty()) no_camera(obs);
   for (const std::string& camera : cameras) append_camera(obs, camera, cloud.xyz, cloud.rgb);
   return cloud;
@@ -149,7 +153,7 @@ ObservationCloud observation_cloud(const stream::Record& obs) {
 
 std::vector<CameraCloud> camera_clouds(const stream::Record& obs) {
   std::vector<CameraCloud> clouds;
-  for (const std::string& camera : obs.prefixes(".rgb")) {
+  for (const std::string& camera : obs.prefixes(fields::per_camera::rgb)) {
     CameraCloud c;
     c.camera = camera;
     std::tie(c.height, c.width) = append_camera(obs, camera, c.cloud.xyz, c.cloud.rgb);
