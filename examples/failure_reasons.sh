@@ -8,7 +8,9 @@
 #        keyframes on these scenes as keyframe(1) discretizes them for the learner (NET_OPTIONS:
 #        its --depths and --offset), acted with qte-select --keyframes: the discretized expert
 #        acting open-loop, a reference for what this grid, planner and task allow. The scenes are learn.sh's evaluation scenes: VARIATION
-#        (0), EVAL_SEED (1000000) and PLAN_OPTIONS as there. FAILURE_EPISODES=1: a line per episode on stderr.
+#        (0), EVAL_SEED (1000000) and PLAN_OPTIONS as there; SCENES=demo with EVAL_SEED and EPISODES a run's SEED and
+#        DEMOS acts on the scenes of its demonstrations instead (has the agent learned the scenes it was shown?).
+#        FAILURE_EPISODES=1: a line per episode on stderr.
 # The expert's episodes of the scenes are recorded once per task, VARIATION, EVAL_SEED,
 # EPISODES, IMAGE and demo-record program (its checksum: a rebuilt expert records again) and
 # kept in EXPERT_CACHE, by default expert-cache/ beside the run directory (the checkpoint's
@@ -21,13 +23,14 @@ shift $(( $# < 7 ? $# : 7 ))
 here=$(cd "$(dirname "$0")" && pwd)
 source "$here/common.sh"
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-scenes=(--task "$task" --variation "${VARIATION:-0}" --episodes "$episodes" --seed "${EVAL_SEED:-1000000}" --scenes eval
+scenes=(--task "$task" --variation "${VARIATION:-0}" --episodes "$episodes" --seed "${EVAL_SEED:-1000000}" --scenes "${SCENES:-eval}"
         --image-size "$image")
 if [ "$checkpoint" = keyframes ]; then cache=${EXPERT_CACHE-}; else
   cache=${EXPERT_CACHE-$(dirname "$(dirname "$checkpoint")")/../expert-cache}; fi
 if [ -n "$cache" ]; then
+  other_scenes=$([ "${SCENES:-eval}" = eval ] || echo "_${SCENES}-scenes")
   build=$(sha256sum "$(command -v demo-record)" | cut -c1-12)
-  experts=$cache/${task}_variation${VARIATION:-0}_seed${EVAL_SEED:-1000000}_episodes${episodes}_${image}_demo-record-$build.rec
+  experts=$cache/${task}${other_scenes}_variation${VARIATION:-0}_seed${EVAL_SEED:-1000000}_episodes${episodes}_${image}_demo-record-$build.rec
 else
   experts=$tmp/experts.rec
 fi

@@ -28,7 +28,8 @@ static cli::Usage usage() {
   };
   u.options = {
       {"task", "T", "one of: " + tasks::task_list(), "", false, true},
-      cli::integer_option("retries", "N", "new seeds to try for an episode whose expert failed", "0", 0, 1000),
+      cli::integer_option("retries", "N", "new seeds to try for an episode whose expert failed",
+                          cli::default_text(demos::DemoOptions{}.retries), 0, 1000),
   };
   u.options.push_back(planning::time_budget_option());
   u.options.push_back(cli::output_file());

@@ -43,7 +43,7 @@ static cli::Usage usage() {
        "also write an observation at every 50 ms control step of a trajectory "
        "(full demonstrations)",
        ""},
-      cli::integer_option("threads", "N", "rendering threads", "2", 1, 256),
+      cli::integer_option("threads", "N", "rendering threads", cli::default_text(sim_step::SimulatorOptions{}.render_threads), 1, 256),
       {"list-tasks", "",
        "print the tasks, one a line: name, variations, episode length and what variation 0 asks "
        "(tab-separated), and exit",

@@ -55,7 +55,8 @@ static cli::Usage usage() {
   u.options = {
       {"json", "", "print JSON Lines instead of text", ""},
       {"type", "T", "show only records of type T", "", true},
-      cli::integer_option("values", "N", "values shown per field; -1 shows all", "6", -1, 1000000000),
+      cli::integer_option("values", "N", "values shown per field; -1 shows all",
+                          cli::default_text(stream::InspectOptions{}.max_values), -1, 1000000000),
       {"all-values", "", "show every value (same as --values -1)", ""},
       {"npy", "DIR",
        "also export the fields of the shown records into DIR: one stacked .npy array per record type and field", ""},

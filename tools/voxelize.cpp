@@ -39,7 +39,8 @@ static cli::Usage usage() {
   u.arguments = {cli::input_file()};
   u.options = {
       {"centre", "X,Y,Z", "also voxelize centre +- offset at depth 1 (repeat for several: one batched pass)", "", true},
-      cli::real_option("offset", "M", "half edge of the deeper grids, metres", "0.15", 0.001, 10),
+      cli::real_option("offset", "M", "half edge of the deeper grids, metres",
+                       cli::default_text(voxels::CoarseToFine{}.offsets_m.front()), 0.001, 10),
       {"octomap-channels", "", "add the free and unknown channels (12 in all)", ""},
       {"png", "DIR", "save a picture of every grid as DIR/<record>.depth<d>[.<k>].png (all at the end, or none)", ""},
   };

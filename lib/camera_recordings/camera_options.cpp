@@ -12,7 +12,7 @@ std::vector<cli::OptionSpec> camera_setup_options() {
       {"intrinsics", "FX,FY,CX,CY", "pinhole intrinsics in pixels (needed for depth images)", ""},
       {"camera-pose", "X,Y,Z,QX,QY,QZ,QW", "camera-to-world pose, metres and unit quaternion", ""},
       {"extrinsics", "M00,...,M33", "camera-to-world 4x4 matrix, 16 numbers row by row (instead of --camera-pose)", ""},
-      cli::real_option("depth-unit", "M", "metres per depth count", "0.001", 1e-6, 1.0),
+      cli::real_option("depth-unit", "M", "metres per depth count", cli::default_text(CameraSetup{}.depth_unit_m), 1e-6, 1.0),
       cli::no_points_option(),
   };
 }
