@@ -1,0 +1,107 @@
+#!/usr/bin/env python3
+"""Where an agent's actions of one step go: for every episode of an agent stream (sim-step
+--objects | qte-select | plan-path, as failure_reasons.sh runs it), the action of step STEP
+(0: the first), its horizontal distance to each of the scene's objects, the object it is
+nearest, and its gripper command. With --demonstrations REPLAY (keyframe's output for the same
+scenes, in the same order) also the demonstrated keyframe of that step: how far the agent's
+pose is from it, and whether depth 0's voxel, the rotation bins and the gripper agree.
+
+A diagnosis, not a score: it tells an agent that goes to the right object and fails there from
+one that goes somewhere else, and which step of the demonstrations it is imitating (an agent
+that goes to a later keyframe's place with a later keyframe's gripper has taken one phase of
+the task for another).
+
+Usage: first_actions.py [--step N] [--demonstrations REPLAY.rec] AGENT.rec > table.csv
+A CSV row per episode, then on stderr a summary line. Run with Debian's python3 (NumPy)."""
+import argparse
+import csv
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "lib", "python"))  # or installed: make install
+import qte_stream  # noqa: E402
+
+
+def text(value):
+    return value if isinstance(value, str) else bytes(value).decode()
+
+
+def agent_actions(path, step):
+    """Per episode, (the objects' names, their positions, the action of `step`), in order: an
+    action is paired with the observation it answers (the last one before it)."""
+    episodes, obs = [], None
+    for record in qte_stream.read_records(path):
+        f = record.fields
+        if record.type == "obs":
+            obs = f
+        elif record.type == "action" and int(f["step"]) == step:
+            if obs is None or "objects.pose" not in obs:
+                sys.exit(f"first_actions.py: {path}: an action with no observation with objects before it "
+                         "(run sim-step with --objects)")
+            names = text(obs["objects.names"]).split(",") if text(obs["objects.names"]) else []
+            positions = np.asarray(obs["objects.pose"], dtype=float).reshape(-1, 7)[:, :3]
+            episodes.append((names, positions, f))
+    return episodes
+
+
+def demonstrated(path, step):
+    """Per demonstrated episode (in file order), its transition of `step` from the earliest
+    frame: the keyframe a demonstration went to at that step."""
+    chosen, order = {}, []
+    for record in qte_stream.read_records(path):
+        f = record.fields
+        if record.type != "transition" or int(f["demo"]) != 1 or int(f["step"]) != step:
+            continue
+        key = int(f["episode_key"])
+        if key not in chosen:
+            order.append(key)
+        if key not in chosen or int(f["frame"]) < int(chosen[key]["frame"]):
+            chosen[key] = f
+    return [chosen[k] for k in order]
+
+
+def rows(episodes, demos):
+    for i, (names, positions, action) in enumerate(episodes):
+        pose = np.asarray(action["pose"], dtype=float)
+        distances = [float(np.linalg.norm(pose[:2] - p[:2])) for p in positions]
+        row = {"episode": i,
+               "nearest": names[int(np.argmin(distances))] if names else "",
+               "gripper_open": int(action["gripper_open"])}
+        row.update({f"cm_to_{n}": f"{100 * d:.1f}" for n, d in zip(names, distances)})
+        if demos is not None:
+            d = demos[i]
+            row["cm_to_demonstrated"] = f"{100 * np.linalg.norm(pose[:3] - np.asarray(d['target_pose'][:3])):.1f}"
+            row["depth0_agrees"] = int(list(action["depth0.index"]) == list(d["depth0.index"]))
+            row["rotation_agrees"] = int(list(action["rotation_bins"]) == list(d["rotation_bins"]))
+            row["demonstrated_gripper_open"] = int(d["gripper_open"])
+        yield row
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("agent")
+    parser.add_argument("--step", type=int, default=0)
+    parser.add_argument("--demonstrations")
+    args = parser.parse_args(argv)
+    episodes = agent_actions(args.agent, args.step)
+    if not episodes:
+        sys.exit(f"first_actions.py: {args.agent}: no action of step {args.step}")
+    demos = demonstrated(args.demonstrations, args.step) if args.demonstrations else None
+    if demos is not None and len(demos) < len(episodes):
+        sys.exit(f"first_actions.py: {args.demonstrations}: {len(demos)} demonstrated episodes with a step "
+                 f"{args.step}, fewer than the agent's {len(episodes)}")
+    table = list(rows(episodes, demos))
+    columns = list(dict.fromkeys(k for row in table for k in row))
+    writer = csv.DictWriter(sys.stdout, columns, lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(table)
+    nearest = [row["nearest"] for row in table]
+    counts = ", ".join(f"{n} {nearest.count(n)}" for n in dict.fromkeys(nearest))
+    closed = sum(row["gripper_open"] == 0 for row in table)
+    print(f"step {args.step}: {len(table)} episodes; nearest object: {counts}; gripper closed in {closed}", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()
