@@ -61,7 +61,7 @@ static void run(const cli::Arguments& args) {
   const auto summary = demos::record_demos(
       robot, options,
       [&](const stream::Record& r) {
-        if (!drop_points || r.type() != "obs") return writer.write(r);
+        if (!drop_points || r.type() != record_type::obs) return writer.write(r);
         stream::Record slim = r;
         for (const auto& camera : options.simulator.cameras) slim.remove(camera.name + fields::per_camera::points);
         writer.write(slim);

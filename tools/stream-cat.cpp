@@ -30,7 +30,7 @@ static cli::Usage usage() {
       {"where", "NAME=VALUE",
        "keep only records whose scalar or text field NAME equals VALUE (numbers compare as numbers)", "", true},
       cli::integer_option("head", "N", "stop after N records have been written; -1 for no limit", "-1", -1,
-                          1000000000000000),
+                          INT64_MAX),
       cli::max_record_bytes_option(),
   };
   u.add_options(cli::append_options());

@@ -10,6 +10,7 @@
 #include "common/indexed_name.hpp"
 #include "common/atomic_file.hpp"
 #include "point_clouds/pcd_file.hpp"
+#include "stream/field_names.hpp"
 #include "stream/inspect.hpp"
 #include "stream/npy.hpp"
 #include "stream/reader.hpp"
@@ -137,7 +138,7 @@ static void run(const cli::Arguments& args) {
       auto& total = totals[record->type()];
       total.first += 1;
       total.second += bytes;
-      if (pcd && (record->type() == "obs" || record->type() == "frame"))
+      if (pcd && (record->type() == record_type::obs || record->type() == record_type::frame))
         for (const auto& camera : voxels::camera_clouds(*record))
           point_clouds::write_pcd(pcd->path(indexed_name(record->position.record_index, camera.camera + ".pcd")), camera);
       if (npy) npy->add(*record);

@@ -39,7 +39,7 @@ static cli::Usage usage() {
   u.arguments = {cli::input_files("record streams")};
   u.options = {
       {"dir", "DIR", "where the PNG files go (created if missing)", "."},
-      {"type", "T", "only records of type T", "obs"},
+      {"type", "T", "only records of type T", record_type::obs},
       {"depth", "", "also save depth images", ""},
       {"depth-mm", "", "also save depth as 16-bit PNGs in millimetres", ""},
       cli::integer_option("every", "N", "only every N-th record of the type", "1", 1, 1000000000),
@@ -89,7 +89,7 @@ static void run(const cli::Arguments& args) {
   std::unique_ptr<video::EpisodeVideo> video;
   std::unique_ptr<OutputDirectory> pictures;
   if (args.has("video")) {
-    if (type != "obs") throw UsageError("--video shows observations: --type obs");
+    if (type != record_type::obs) throw UsageError("--video shows observations: --type obs");
     video = std::make_unique<video::EpisodeVideo>(args.text("video"), args.real("fps"), args.text("camera"),
                                                   args.text("attention"), static_cast<int>(args.integer("height")));
   } else {

@@ -65,9 +65,9 @@ static void run(const cli::Arguments& args) {
   for (const std::string& file : files) {
     stream::RecordReader reader(file);
     while (auto record = reader.next()) {
-      if (record->type() == "obs" && record->has(fields::gripper_opening_m))
+      if (record->type() == record_type::obs && record->has(fields::gripper_opening_m))
         episode.observe_gripper(record->scalar<double>(fields::gripper_opening_m));
-      if (record->type() != "trajectory") continue;
+      if (record->type() != record_type::trajectory) continue;
       const auto index = static_cast<unsigned long long>(record->position.record_index);
       if (record->has(fields::failure) && !record->has(fields::time_s)) {
         std::cerr << "xarm-export: " << file << ": record " << index << ": no motion ("

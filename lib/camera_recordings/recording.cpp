@@ -13,6 +13,7 @@
 #include "keyframes/keyframes.hpp"
 #include "point_clouds/pcd_file.hpp"
 #include "robot/pose_values.hpp"
+#include "stream/field_names.hpp"
 #include "tasks/episode.hpp"
 #include "voxels/observation_cloud.hpp"
 #include "world/scene_layout.hpp"
@@ -129,7 +130,7 @@ PackedRecording pack_recording(const Recording& recording, const robot::RobotMod
                     std::to_string(recording.start) + ")");
       break;
     }
-    stream::Record obs("obs");
+    stream::Record obs(record_type::obs);
     if (images) {
       const std::string depth_path = frame_path(recording.depth_pattern, index);
       add_camera_images(obs, recording.camera, read_colour_png(first), read_depth_png(depth_path),

@@ -26,7 +26,7 @@ namespace qte::cli {
 namespace {
 
 // Upper bounds that stand for "no bound" (INT64_MAX, 1e30): --help and the errors leave them unsaid.
-constexpr double kUnboundedInteger = 1e15;
+constexpr double kUnboundedInteger = 9.2e18;  // INT64_MAX as a double is 2^63
 constexpr double kUnboundedReal = 1e30;
 
 // Options every tool has, appended to the tool's own.

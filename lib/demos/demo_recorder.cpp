@@ -66,7 +66,7 @@ DemoSummary record_demos(const robot::RobotModel& robot, DemoOptions options,
       ++attempts;
     } while (!attempt.success && attempts <= options.retries);
     for (const auto& r : attempt.records) emit(r);
-    stream::Record episode("episode");
+    stream::Record episode(record_type::episode);
     episode.set_string(fields::task, options.episodes.task);
     episode.set_scalar<int32_t>(fields::episode, e);
     episode.set_scalar<int32_t>(fields::variation, attempt.variation);

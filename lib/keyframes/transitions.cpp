@@ -1,6 +1,7 @@
 #include "keyframes/transitions.hpp"
 
 #include <cmath>
+#include <cstring>
 #include <set>
 
 #include "common/random.hpp"
@@ -63,11 +64,11 @@ std::string ConversionCounts::summary() const {
 AgentEpisodeConverter::AgentEpisodeConverter(TransitionOptions options) : options_(std::move(options)) {}
 
 void AgentEpisodeConverter::handle(const stream::Record& record, const stream::Emit& emit) {
-  if (record.type() == "obs") {
+  if (record.type() == record_type::obs) {
     if (!observations_.empty() && record.scalar<int32_t>(fields::step) == 0) convert(emit);  // a new episode
     observations_.push_back(record);
     if (record.scalar<uint8_t>(fields::terminal) != 0) convert(emit);
-  } else if (record.type() == "action" && !observations_.empty()) {
+  } else if (record.type() == record_type::action && !observations_.empty()) {
     if (actions_.size() + 1 != observations_.size())
       throw StreamError(record.position, "'action' record without an observation of its own before it");
     actions_.push_back(record);
@@ -88,7 +89,7 @@ void AgentEpisodeConverter::convert(const stream::Emit& emit) {
     const voxels::CoarseToFine& h = options_.hierarchy;
     for (std::size_t t = 0; t < steps; ++t) {
       const stream::Record &obs = observations_[t], &action = actions_[t], &next = observations_[t + 1];
-      stream::Record r("transition");
+      stream::Record r(record_type::transition);
       r.set_scalar<int64_t>(fields::episode_key, episode_key);
       r.set_scalar<int32_t>(fields::frame, obs.scalar<int32_t>(fields::frame));
       r.set_scalar<int32_t>(fields::next_frame, next.scalar<int32_t>(fields::frame));
@@ -140,7 +141,7 @@ void AgentEpisodeConverter::convert(const stream::Emit& emit) {
 }
 
 stream::Record frame_record(const stream::Record& obs, int64_t episode_key) {
-  stream::Record frame("frame");
+  stream::Record frame(record_type::frame);
   frame.set_scalar<int64_t>(fields::episode_key, episode_key);
   frame.set_scalar<int32_t>(fields::frame, obs.scalar<int32_t>(fields::frame));
   for (const auto& field : obs.fields()) {
@@ -152,7 +153,9 @@ stream::Record frame_record(const stream::Record& obs, int64_t episode_key) {
     } else if (stream::ends_with(name, fields::per_camera::depth)) {
       // Millimetres in 16 bits: 0.5 mm rounding, far below a 1.9 cm voxel, half the bytes.
       const auto depth = obs.array<float>(name);
-      frame.set<uint16_t>(name + "_mm", depth.shape, voxels::depth_in_mm(depth.data, depth.size()), /*compress=*/true);
+      const std::string camera = name.substr(0, name.size() - std::strlen(fields::per_camera::depth));
+      frame.set<uint16_t>(camera + fields::per_camera::depth_mm, depth.shape,
+                          voxels::depth_in_mm(depth.data, depth.size()), /*compress=*/true);
     } else if (stream::ends_with(name, fields::per_camera::depth_mm)) {  // a depth camera's own millimetres (obs-pack)
       stream::Field mm = field;
       mm.compress = true;
@@ -177,10 +180,10 @@ stream::Record frame_record(const stream::Record& obs, int64_t episode_key) {
 EpisodeConverter::EpisodeConverter(TransitionOptions options) : options_(std::move(options)), rng_(options_.seed) {}
 
 void EpisodeConverter::handle(const stream::Record& record, const stream::Emit& emit) {
-  if (record.type() == "episode") {
+  if (record.type() == record_type::episode) {
     convert(episode_, &record, emit);
     episode_.clear();
-  } else if (record.type() == "obs") {
+  } else if (record.type() == record_type::obs) {
     if (!episode_.empty() && record.scalar<int32_t>(fields::frame) == 0) {
       convert(episode_, nullptr, emit);
       episode_.clear();
@@ -285,7 +288,7 @@ stream::Record EpisodeConverter::transition(const std::vector<stream::Record>& e
       shifts[d] = Eigen::Vector3d(shift(rng_), shift(rng_), shift(rng_)) * h.offset_at(d);
   const auto indices = h.indices_of(pose.translation(), shifts);
 
-  stream::Record t("transition");
+  stream::Record t(record_type::transition);
   t.set_scalar<int64_t>(fields::episode_key, episode_key);
   t.set_scalar<int32_t>(fields::frame, episode[from].scalar<int32_t>(fields::frame));
   t.set_scalar<int32_t>(fields::next_frame, target.scalar<int32_t>(fields::frame));

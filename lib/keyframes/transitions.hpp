@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "stream/field_names.hpp"
 #include "stream/record.hpp"
 #include "stream/stage.hpp"
 #include "voxels/voxel_grid.hpp"
@@ -44,7 +45,7 @@ class EpisodeConverter : public stream::Stage {
   // Feed a demonstration stream record by record: obs records gather into an episode, which
   // ends at an 'episode' record or at an obs with frame 0; finish() converts the last one.
   void handle(const stream::Record& record, const stream::Emit& emit) override;
-  std::vector<std::string> reads() const override { return {"obs"}; }
+  std::vector<std::string> reads() const override { return {record_type::obs}; }
   void finish(const stream::Emit& emit) override;
   const ConversionCounts& counts() const { return counts_; }
 
@@ -73,7 +74,7 @@ class AgentEpisodeConverter : public stream::Stage {
  public:
   explicit AgentEpisodeConverter(TransitionOptions options);
   void handle(const stream::Record& record, const stream::Emit& emit) override;
-  std::vector<std::string> reads() const override { return {"obs"}; }
+  std::vector<std::string> reads() const override { return {record_type::obs}; }
   void finish(const stream::Emit& emit) override;
   const ConversionCounts& counts() const { return counts_; }
 

@@ -154,7 +154,7 @@ stream::Record QLearner::load(const std::string& path) {
   stream::RecordReader reader(path);
   std::optional<stream::Record> online, target, extra;
   while (auto record = reader.next()) {
-    std::optional<stream::Record>& slot = record->type() != "checkpoint" ? extra
+    std::optional<stream::Record>& slot = record->type() != record_type::checkpoint ? extra
                                           : record->has(fields::role) && record->string(fields::role) == "target"
                                               ? target
                                               : online;

@@ -28,7 +28,7 @@ bool exists(const std::string& path) {
 }
 
 bool is_agent_transition(const stream::Record& r) {
-  return r.type() == "transition" && !(r.has(fields::demo) && r.scalar<uint8_t>(fields::demo) != 0);
+  return r.type() == record_type::transition && !(r.has(fields::demo) && r.scalar<uint8_t>(fields::demo) != 0);
 }
 
 // With an adaptive tree target, the mean branches it expanded at depths 1.. come last.
@@ -97,7 +97,7 @@ void TrainingLoop::ingest(int64_t agent_limit, bool fill_to_start_after, int64_t
   for (auto& r : inputs_.poll()) pending_.push_back(std::move(r));
   while (!pending_.empty()) {
     const stream::Record& r = pending_.front();
-    if (r.type() == "transition") {
+    if (r.type() == record_type::transition) {
       if (transitions_read_ >= total_limit) break;
       const bool agent = is_agent_transition(r);
       const bool wanted = agent_transitions_ < agent_limit ||
@@ -114,7 +114,7 @@ void TrainingLoop::ingest(int64_t agent_limit, bool fill_to_start_after, int64_t
 }
 
 void TrainingLoop::save() {
-  stream::Record state("learner");
+  stream::Record state(record_type::learner);
   state.set_scalar<int64_t>(fields::step, learner_.step());
   state.set_scalar<int64_t>(fields::transitions_read, transitions_read_);
   state.set_scalar<int64_t>(fields::agent_transitions, agent_transitions_);

@@ -58,9 +58,7 @@ CheckpointConfig stack_config(const std::vector<QAttentionNet>& nets) {
 
 // `depth<digit>...` and `adam....`: the names of tensors, as opposed to config fields.
 bool is_tensor_name(const std::string& name) {
-  const bool depth_tensor =
-      name.rfind("depth", 0) == 0 && name.size() > 5 && std::isdigit(static_cast<unsigned char>(name[5]));
-  return depth_tensor || name.rfind(fields::adam_prefix, 0) == 0;
+  return fields::is_per_depth(name) || name.rfind(fields::adam_prefix, 0) == 0;
 }
 
 // One tensor to load: where it comes from and where it goes.
@@ -73,7 +71,7 @@ struct PendingCopy {
 
 stream::Record checkpoint_record(const std::vector<QAttentionNet>& nets, const torch::optim::Adam* adam, int64_t step) {
   CheckpointConfig config = stack_config(nets);
-  stream::Record record("checkpoint");
+  stream::Record record(record_type::checkpoint);
   record.set_string(fields::architecture, architecture_name(config.net.architecture));
   record.set_scalar<int64_t>(fields::base_channels, config.net.base_channels);
   record.set_scalar<int64_t>(fields::voxels, config.net.voxels);
@@ -111,7 +109,7 @@ void save_checkpoint(const std::string& path, const std::vector<QAttentionNet>& 
 }
 
 CheckpointConfig checkpoint_config(const stream::Record& record) {
-  if (record.type() != "checkpoint")
+  if (record.type() != record_type::checkpoint)
     throw StreamError(record.position, "expected a 'checkpoint' record, got '" + record.type() + "'");
   // Checked before anything is built from them: a damaged or hostile count would otherwise ask
   // for networks of terabytes.
@@ -140,7 +138,7 @@ stream::Record read_online_checkpoint(const std::string& path) {
   stream::RecordReader reader(path);
   std::optional<stream::Record> online;
   while (std::optional<stream::Record> record = reader.next()) {
-    if (record->type() != "checkpoint" || record->has(fields::role)) continue;
+    if (record->type() != record_type::checkpoint || record->has(fields::role)) continue;
     if (online)
       throw StreamError(record->position, "a second online 'checkpoint' record (the first is record " +
                                               std::to_string(online->position.record_index) +

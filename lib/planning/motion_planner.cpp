@@ -308,7 +308,7 @@ std::vector<robot::JointVector> MotionPlanner::rrt_connect(const StartState& sta
 }
 
 stream::Record action_record(const Goal& goal) {
-  stream::Record action("action");
+  stream::Record action(record_type::action);
   action.set<double>(fields::pose, {robot::kPoseValues}, robot::pose_values(goal.tcp_pose));
   action.set_scalar<uint8_t>(fields::gripper_open, goal.gripper_open);
   action.set_scalar<uint8_t>(fields::ignore_collisions, goal.ignore_collisions);
@@ -321,12 +321,12 @@ PlanPathFilter::PlanPathFilter(const robot::RobotModel& robot, const Eigen::Isom
 
 void PlanPathFilter::handle(const stream::Record& record, const stream::Emit& emit) {
   emit(record);
-  if (record.type() == "obs") {
+  if (record.type() == record_type::obs) {
     obs_ = prepare_ ? prepare_(record) : record;
     scene_.reset();
     return;
   }
-  if (record.type() != "action") return;
+  if (record.type() != record_type::action) return;
   if (!obs_)
     throw StreamError(record.position, "action before any observation: plan-path needs the 'obs' record "
                                        "(joint state and point cloud) ahead of each action");
@@ -337,7 +337,7 @@ void PlanPathFilter::handle(const stream::Record& record, const stream::Emit& em
 }
 
 stream::Record trajectory_record(const PlanResult& plan, const Goal& goal) {
-  stream::Record t("trajectory");
+  stream::Record t(record_type::trajectory);
   if (!plan.failure.empty()) {
     t.set_string(fields::failure, plan.failure);
   } else {

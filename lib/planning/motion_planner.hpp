@@ -16,6 +16,7 @@
 #include "planning/collision_checker.hpp"
 #include "planning/occupancy_scene.hpp"
 #include "planning/robot_spheres.hpp"
+#include "stream/field_names.hpp"
 #include "world/scene_layout.hpp"
 #include "robot/inverse_kinematics.hpp"
 #include "stream/record.hpp"
@@ -123,7 +124,7 @@ class PlanPathFilter : public stream::Stage {
  public:
   PlanPathFilter(const robot::RobotModel& robot, const Eigen::Isometry3d& world_from_base, PlannerOptions options);
   void handle(const stream::Record& record, const stream::Emit& emit) override;
-  std::vector<std::string> reads() const override { return {"action"}; }
+  std::vector<std::string> reads() const override { return {record_type::action}; }
   // Plans on what `prepare` makes of each observation (point-cloud filters) instead of the
   // observation itself; records still pass through unchanged.
   void observe_through(std::function<stream::Record(const stream::Record&)> prepare) { prepare_ = std::move(prepare); }

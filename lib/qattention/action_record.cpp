@@ -14,7 +14,7 @@ namespace qte::qattention {
 stream::Record action_record(const Choice& choice, bool ignore_collisions, int k, bool explored,
                              int64_t checkpoint_step, int32_t step) {
   const Choice& c = choice;
-  stream::Record a("action");
+  stream::Record a(record_type::action);
   const Eigen::Vector3d p = c.position();
   Eigen::Quaterniond q(robot::rotation_from_bins(c.rotation_bins));
   q.normalize();

@@ -43,8 +43,8 @@ std::vector<std::vector<Choice>> demonstrated_keyframes(const std::string& trans
   std::size_t transitions = 0;
   stream::RecordReader reader(transitions_path);
   while (auto record = reader.next()) {
-    if (record->type() != "frame" && record->type() != "transition") continue;
-    transitions += record->type() == "transition";
+    if (record->type() != record_type::frame && record->type() != record_type::transition) continue;
+    transitions += record->type() == record_type::transition;
     records.push_back(std::move(*record));
   }
   if (transitions == 0) throw Error(transitions_path + ": no 'transition' records: expected keyframe(1)'s output");
@@ -79,7 +79,7 @@ KeyframeStage::KeyframeStage(std::vector<std::vector<Choice>> demonstrations, st
 
 void KeyframeStage::handle(const stream::Record& record, const stream::Emit& emit) {
   emit(record);
-  if (record.type() != "obs") return;
+  if (record.type() != record_type::obs) return;
   if (record.has(fields::terminal) && record.scalar<uint8_t>(fields::terminal) != 0) return;
   const int32_t step = record.scalar<int32_t>(fields::step);
   if (step < 0) record.fail(fields::step, "a step of 0 or more");

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "qattention/tree_expansion.hpp"
+#include "stream/field_names.hpp"
 #include "stream/stage.hpp"
 
 namespace qte::qattention {
@@ -29,7 +30,7 @@ class KeyframeStage : public stream::Stage {
   // `ignore_collisions`: every action's, as qte-select --ignore-collisions sets it for networks.
   KeyframeStage(std::vector<std::vector<Choice>> demonstrations, std::string source, bool ignore_collisions);
   void handle(const stream::Record& record, const stream::Emit& emit) override;
-  std::vector<std::string> reads() const override { return {"obs"}; }
+  std::vector<std::string> reads() const override { return {record_type::obs}; }
 
  private:
   std::vector<std::vector<Choice>> demonstrations_;

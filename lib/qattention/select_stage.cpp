@@ -33,7 +33,7 @@ Action SelectStage::act_on(const stream::Record& obs, const voxels::ObservationC
 
 void SelectStage::handle(const stream::Record& record, const stream::Emit& emit) {
   emit(record);
-  if (record.type() != "obs") return;
+  if (record.type() != record_type::obs) return;
   if (record.has(fields::terminal) && record.scalar<uint8_t>(fields::terminal) != 0) return;
   const int32_t step = record.scalar<int32_t>(fields::step);
   if (options_.reload && step == 0 && networks_.reload_if_changed())

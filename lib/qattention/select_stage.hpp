@@ -7,6 +7,7 @@
 #include <string>
 
 #include "qattention/acting.hpp"
+#include "stream/field_names.hpp"
 #include "stream/stage.hpp"
 #include "voxels/observation_cloud.hpp"
 
@@ -28,7 +29,7 @@ class SelectStage : public stream::Stage {
  public:
   SelectStage(CheckpointNetworks& networks, SelectOptions options);
   void handle(const stream::Record& record, const stream::Emit& emit) override;
-  std::vector<std::string> reads() const override { return {"obs"}; }
+  std::vector<std::string> reads() const override { return {record_type::obs}; }
   uint64_t actions() const { return actions_; }
 
  private:

@@ -20,13 +20,13 @@ ReplayBuffer::ReplayBuffer(ReplayOptions options) : options_(options), tree_(opt
 }
 
 bool ReplayBuffer::add(const stream::Record& record) {
-  if (record.type() == "frame") {
+  if (record.type() == record_type::frame) {
     const FrameKey key{record.scalar<int64_t>(fields::episode_key), record.scalar<int32_t>(fields::frame)};
     auto it = frames_.find(key);
     if (it == frames_.end()) frames_.emplace(key, std::make_pair(record, 0));
     return true;
   }
-  if (record.type() != "transition") return false;
+  if (record.type() != record_type::transition) return false;
   Stored stored{record,
                 {record.scalar<int64_t>(fields::episode_key), record.scalar<int32_t>(fields::frame)},
                 {record.scalar<int64_t>(fields::episode_key), record.scalar<int32_t>(fields::next_frame)},

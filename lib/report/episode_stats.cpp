@@ -29,7 +29,7 @@ void EpisodeSplitter::report_unfinished(const std::string& where) {
 }
 
 void EpisodeSplitter::handle(const stream::Record& obs) {
-  if (obs.type() != "obs") return;
+  if (obs.type() != record_type::obs) return;
   if (observations_ > 0 && obs.has(fields::frame) && obs.scalar<int32_t>(fields::frame) == 0) {
     report_unfinished("before record " + std::to_string(obs.position.record_index));
     observations_ = 0;
@@ -66,7 +66,7 @@ std::vector<Episode> read_episodes(const std::string& path, std::function<void(c
     ++counts[record->type()];
     splitter.handle(*record);
   }
-  stream::require_record_types(reader, counts, {"obs"});  // a replay is not episodes
+  stream::require_record_types(reader, counts, {record_type::obs});  // a replay is not episodes
   splitter.finish();
   return splitter.episodes();
 }

@@ -89,8 +89,8 @@ std::string RobotWorld::arm_outside(const robot::JointVector& q, double opening_
 }
 
 void RobotWorld::handle(const stream::Record& record, const stream::Emit& emit) {
-  if (record.type() == "reset") reset(record, emit);
-  else if (record.type() == "trajectory") execute(record, emit);
+  if (record.type() == record_type::reset) reset(record, emit);
+  else if (record.type() == record_type::trajectory) execute(record, emit);
 }
 
 std::string RobotWorld::send(const std::vector<robot::XarmRow>& rows, const std::string& what) {
@@ -136,7 +136,7 @@ std::string RobotWorld::send(const std::vector<robot::XarmRow>& rows, const std:
 stream::Record RobotWorld::observe() {
   const CaptureAnswer frame = spool_.capture();
   if (!frame.fault.empty()) throw Error("the camera recorder on " + spool_.directory() + ": " + frame.fault);
-  stream::Record obs("obs");
+  stream::Record obs(record_type::obs);
   camera_recordings::add_camera_images(obs, options_.camera, camera_recordings::read_colour_png(frame.colour_png),
                                        camera_recordings::read_depth_png(frame.depth_png),
                                        frame.colour_png + " and " + frame.depth_png);

@@ -65,7 +65,7 @@ Simulator::Simulator(const robot::RobotModel& robot, SimulatorOptions options)
 Simulator::~Simulator() = default;
 
 stream::Record Simulator::observe(const std::string& failure) {
-  stream::Record obs("obs");
+  stream::Record obs(record_type::obs);
   for (const auto& camera : options_.cameras) {
     const render::CameraFrame frame =
         render::render(world_->collision_world(), camera.intrinsics, camera_pose(camera.name, *world_),
@@ -127,8 +127,8 @@ void set_object_fields(stream::Record& obs, const world::World& world) {
 }
 
 void Simulator::handle(const stream::Record& record, const stream::Emit& emit) {
-  if (record.type() == "reset") reset(record, emit);
-  else if (record.type() == "trajectory") execute(record, emit);
+  if (record.type() == record_type::reset) reset(record, emit);
+  else if (record.type() == record_type::trajectory) execute(record, emit);
 }
 
 void Simulator::reset(const stream::Record& record, const stream::Emit& emit) {
@@ -267,7 +267,7 @@ stream::Record plan_reset(const EpisodePlan& plan, int index) {
   int variation = plan.variation;
   if (variation < 0)  // not from the low bits: they name the scene set
     variation = static_cast<int>(derive_seed(seed, 0x7a) % tasks::make_task(plan.task)->variation_count());
-  stream::Record reset("reset");
+  stream::Record reset(record_type::reset);
   reset.set_string(fields::task, plan.task);
   reset.set_scalar<int32_t>(fields::variation, variation);
   reset.set_scalar<int64_t>(fields::seed, static_cast<int64_t>(seed));

@@ -1,5 +1,5 @@
-// The names of the record fields (formats/record-stream.md, section 12), one constant each, so
-// that every writer and reader spells a name once: record_types.cpp lists the registry's fields
+// The names of the record fields and record types (formats/record-stream.md, section 12), one
+// constant each, so that every writer and reader spells a name once: record_types.cpp lists the registry's fields
 // by these constants, tests/unit/stream/test_field_names.cpp holds the lists equal, and
 // tests/tools/test_field_names.py finds no field named by a string literal in lib/ or tools/.
 // Written `fields::gripper_open` anywhere in qte (the alias at the end).
@@ -89,6 +89,19 @@ namespace qte::stream::fields {
   X(argmax_index, ".argmax_index")  \
   X(grid, ".grid")
 
+// X(constant, "name"): every record type of the registry.
+#define QTE_RECORD_TYPES(X)     \
+  X(reset, "reset")             \
+  X(obs, "obs")                 \
+  X(voxels, "voxels")           \
+  X(action, "action")           \
+  X(trajectory, "trajectory")   \
+  X(episode, "episode")         \
+  X(frame, "frame")             \
+  X(transition, "transition")   \
+  X(checkpoint, "checkpoint")   \
+  X(learner, "learner")
+
 #define QTE_FIELD_CONSTANT(constant, name) inline constexpr char constant[] = name;
 QTE_FIELD_NAMES(QTE_FIELD_CONSTANT)
 namespace per_camera {
@@ -97,12 +110,16 @@ QTE_CAMERA_FIELD_SUFFIXES(QTE_FIELD_CONSTANT)
 namespace per_depth {
 QTE_DEPTH_FIELD_SUFFIXES(QTE_FIELD_CONSTANT)
 }
-#undef QTE_FIELD_CONSTANT
 
 // "depth<d>." : the prefix of a depth's fields, network parameters included
 // ("depth0.conv1.weight"); the optimiser's state is under "adam." + depth_prefix(d).
 inline std::string depth_prefix(int depth) { return "depth" + std::to_string(depth) + "."; }
 inline std::string depth_field(int depth, const char* suffix) { return "depth" + std::to_string(depth) + suffix; }
+// Whether `name` is a depth's field or network parameter: "depth<digits>.…".
+inline bool is_per_depth(const std::string& name) {
+  const std::size_t after = name.find_first_not_of("0123456789", 5);
+  return name.rfind("depth", 0) == 0 && after != std::string::npos && after > 5 && name[after] == '.';
+}
 inline constexpr char adam_prefix[] = "adam.";
 // Adam's state per parameter: "<adam.depth<d>.<parameter>><suffix>".
 namespace per_parameter {
@@ -114,6 +131,13 @@ inline constexpr char step[] = ".step";
 
 }  // namespace qte::stream::fields
 
+// The record types' names: record.type() == record_type::obs, stream::Record r(record_type::transition).
+namespace qte::stream::record_type {
+QTE_RECORD_TYPES(QTE_FIELD_CONSTANT)
+}  // namespace qte::stream::record_type
+#undef QTE_FIELD_CONSTANT
+
 namespace qte {
 namespace fields = stream::fields;
+namespace record_type = stream::record_type;
 }

@@ -288,16 +288,16 @@ std::vector<FieldSchema> table(const FieldSchema (&fields)[N]) {
 
 const std::vector<RecordType>& record_types() {
   static const std::vector<RecordType> types = {
-      {"reset", "episode starts", "the actor loop (sim-step --task writes its own)", table(reset_fields)},
-      {"obs", "observations", "sim-step, robot-step, obs-pack or demo-record", table(obs_fields)},
-      {"voxels", "voxel grids", "voxelize", table(voxels_fields)},
-      {"action", "next-best poses", "qte-select", table(action_fields)},
-      {"trajectory", "planned motions", "plan-path", table(trajectory_fields)},
-      {"episode", "ends of recorded demonstrations", "demo-record or obs-pack", table(episode_fields)},
-      {"frame", "replay frames", "keyframe", table(frame_fields)},
-      {"transition", "replay transitions", "keyframe", table(transition_fields)},
-      {"checkpoint", "network weights", "qattn-train", table(checkpoint_fields)},
-      {"learner", "a training run's state", "qattn-train", table(learner_fields)},
+      {record_type::reset, "episode starts", "the actor loop (sim-step --task writes its own)", table(reset_fields)},
+      {record_type::obs, "observations", "sim-step, robot-step, obs-pack or demo-record", table(obs_fields)},
+      {record_type::voxels, "voxel grids", "voxelize", table(voxels_fields)},
+      {record_type::action, "next-best poses", "qte-select", table(action_fields)},
+      {record_type::trajectory, "planned motions", "plan-path", table(trajectory_fields)},
+      {record_type::episode, "ends of recorded demonstrations", "demo-record or obs-pack", table(episode_fields)},
+      {record_type::frame, "replay frames", "keyframe", table(frame_fields)},
+      {record_type::transition, "replay transitions", "keyframe", table(transition_fields)},
+      {record_type::checkpoint, "network weights", "qattn-train", table(checkpoint_fields)},
+      {record_type::learner, "a training run's state", "qattn-train", table(learner_fields)},
   };
   return types;
 }

@@ -19,7 +19,7 @@ ObservedSpace::ObservedSpace(const stream::Record& obs, double resolution_m) {
   impl_ = std::make_unique<Impl>(options);
   for (const std::string& camera : obs.prefixes(fields::per_camera::extrinsics)) {
     const std::string name = camera + fields::per_camera::extrinsics;
-    stream::Record one("obs");  // one camera at a time: its rays start at its own origin
+    stream::Record one(record_type::obs);  // one camera at a time: its rays start at its own origin
     for (const char* part :
          {fields::per_camera::rgb, fields::per_camera::points, fields::per_camera::depth, fields::per_camera::depth_mm,
           fields::per_camera::intrinsics, fields::per_camera::extrinsics})

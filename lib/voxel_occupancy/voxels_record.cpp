@@ -54,7 +54,7 @@ VoxelsOfObservation voxels_of(const stream::Record& obs, const VoxelsRecordOptio
 
 void VoxelizeStage::handle(const stream::Record& record, const stream::Emit& emit) {
   emit(record);
-  if (record.type() != "obs") return;
+  if (record.type() != record_type::obs) return;
   const VoxelsOfObservation out = voxels_of(prepare_ ? prepare_(record) : record, options_);
   if (!png_dir_.empty()) save_pictures(record.position.record_index, out.grids);
   emit(out.record);

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "stream/field_names.hpp"
 #include "stream/record.hpp"
 #include "stream/stage.hpp"
 #include "voxels/voxel_grid.hpp"
@@ -22,7 +23,7 @@ struct VoxelsRecordOptions {
 };
 
 struct VoxelsOfObservation {
-  stream::Record record{"voxels"};
+  stream::Record record{record_type::voxels};
   // The grids with kChannels, depth 0 first, then each crop (for pictures).
   std::vector<float> grids;
 };
@@ -38,7 +39,7 @@ class VoxelizeStage : public stream::Stage {
                 std::function<stream::Record(const stream::Record&)> prepare = nullptr)
       : options_(std::move(options)), png_dir_(std::move(png_dir)), prepare_(std::move(prepare)) {}
   void handle(const stream::Record& record, const stream::Emit& emit) override;
-  std::vector<std::string> reads() const override { return {"obs"}; }
+  std::vector<std::string> reads() const override { return {record_type::obs}; }
 
  private:
   void save_pictures(uint64_t record_index, const std::vector<float>& grids) const;

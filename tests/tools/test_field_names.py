@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
-"""Every program names a record field through lib/stream/field_names.hpp, never by a string
-literal: no call of a record's accessors (set, set_scalar, set_string, array, scalar, string,
-has, field, find, fail, remove, require_finite) in lib/ or tools/ takes a literal that is a field
-name of formats/record-stream.md, and no per-camera or per-depth suffix (".rgb", ".index") is
-written as a literal. The check is first tried on sample lines, so that it is known to catch
+"""Every program names a record field and a record type through lib/stream/field_names.hpp,
+never by a string literal: no call of a record's accessors (set, set_scalar, set_string, array,
+scalar, string, has, field, find, fail, remove, require_finite) in lib/ or tools/ takes a literal
+that is a field name of formats/record-stream.md, no per-camera or per-depth suffix (".rgb",
+".index") is written as a literal, and no record type is compared with, built from or listed as
+a literal (`type() == "obs"`, `stream::Record r("obs")`, `return {"obs"};`). The check is first tried on sample lines, so that it is known to catch
 what it looks for. Command-line options (`args.has("task")`) are not fields and pass."""
 import os
 import re
@@ -24,13 +25,15 @@ def listed(macro):
 
 names = listed("QTE_FIELD_NAMES(X)")
 suffixes = listed("QTE_CAMERA_FIELD_SUFFIXES(X)") | listed("QTE_DEPTH_FIELD_SUFFIXES(X)")
-assert len(names) > 40 and len(suffixes) == 12, (len(names), len(suffixes))
+types = listed("QTE_RECORD_TYPES(X)")
+assert len(names) > 40 and len(suffixes) == 12 and len(types) == 10, (len(names), len(suffixes), len(types))
 
 ACCESSOR = re.compile(
     r'\b(\w+)(?:\([^()]*\))?(?:\.|->)'
     r'(?:set|set_raw|set_scalar|set_string|array|scalar|string|has|field|find|fail|remove|require_finite)'
     r'(?:<[^<>]*>)?\(\s*"([^"]*)"')
 LITERAL = re.compile(r'"((?:[^"\\]|\\.)*)"')
+TYPE_USE = re.compile(r'(?:type\(\)\s*[!=]=\s*|Record\s+\w+\s*[({]\s*|Record\s*[({]\s*|return\s*\{\s*)"([a-z_]+)"')
 
 
 def problems(line):
@@ -42,6 +45,9 @@ def problems(line):
     for literal in LITERAL.findall(line):
         if literal in suffixes:
             found.append(f'suffix "{literal}" written as a literal')
+    for literal in TYPE_USE.findall(line):
+        if literal in types:
+            found.append(f'record type "{literal}" written as a literal')
     return found
 
 
@@ -49,10 +55,13 @@ def problems(line):
 for line in ['  obs.set_scalar<uint8_t>("gripper_open", 1);', '  if (record->has("failure")) return;',
              '  t.fail("step", "a step");', '  out.remove(camera + ".depth_mm");',
              '  const auto q = replay.transition(last).scalar<int32_t>("step");',
-             '  a.set<int32_t>("depth0" ".index", {3}, x);']:
+             '  a.set<int32_t>("depth0" ".index", {3}, x);', '  if (record->type() != "obs") return;',
+             '  stream::Record t("transition");', '  stream::Record record{"voxels"};',
+             '  std::vector<std::string> reads() const override { return {"obs"}; }']:
     assert problems(line), line
 for line in ['  obs.set_scalar<uint8_t>(fields::gripper_open, 1);', '  if (args.has("task")) run();',
-             '  save(path + ".png");', '  std::string("success") + rest;']:
+             '  save(path + ".png");', '  std::string("success") + rest;',
+             '  if (record.type() == record_type::obs) return;', '  run("reset");']:
     assert not problems(line), line
 
 
@@ -88,7 +97,7 @@ for top in ("lib", "tools"):
                 continue
             checked += 1
             for number, line in code_lines(path):
-                failures += [f"{relative}:{number}: {p} (use fields::… from stream/field_names.hpp)"
+                failures += [f"{relative}:{number}: {p} (use fields::… or record_type::… from stream/field_names.hpp)"
                              for p in problems(line)]
 
 assert checked > 100, checked
@@ -96,4 +105,4 @@ for f in failures:
     print("FAIL:", f)
 if failures:
     sys.exit(1)
-print(f"ok: {checked} files name record fields through stream/field_names.hpp")
+print(f"ok: {checked} files name record fields and types through stream/field_names.hpp")

@@ -15,6 +15,7 @@ namespace {
 const std::set<std::string> kNames = {QTE_FIELD_NAMES(QTE_LISTED)};
 const std::set<std::string> kCameraSuffixes = {QTE_CAMERA_FIELD_SUFFIXES(QTE_LISTED)};
 const std::set<std::string> kDepthSuffixes = {QTE_DEPTH_FIELD_SUFFIXES(QTE_LISTED)};
+const std::set<std::string> kRecordTypes = {QTE_RECORD_TYPES(QTE_LISTED)};
 #undef QTE_LISTED
 
 // Every field name of the registry, each sorted into what it is: a plain name, a per-camera
@@ -58,9 +59,22 @@ TEST(FieldNames, DepthSuffixesAreTheRegistrysPerDepthFields) {
   EXPECT_EQ(kDepthSuffixes, registry_names().depth_suffixes);
 }
 
+TEST(FieldNames, RecordTypesAreTheRegistrys) {
+  std::set<std::string> registry;
+  for (const stream::RecordType& type : stream::record_types()) registry.insert(type.name);
+  EXPECT_EQ(kRecordTypes, registry);
+  EXPECT_EQ(stream::find_record_type(record_type::transition)->name, std::string("transition"));
+}
+
 // The composed names are the specification's patterns filled in.
 TEST(FieldNames, ComposedNames) {
   EXPECT_EQ(fields::depth_field(0, fields::per_depth::index), "depth0.index");
+  EXPECT_TRUE(fields::is_per_depth("depth0.index"));
+  EXPECT_TRUE(fields::is_per_depth("depth12.conv.weight"));
+  EXPECT_FALSE(fields::is_per_depth("depths"));
+  EXPECT_FALSE(fields::is_per_depth("depth.index"));
+  EXPECT_FALSE(fields::is_per_depth("depth3"));
+  EXPECT_FALSE(fields::is_per_depth("adam.depth0.w.step"));
   EXPECT_EQ(fields::depth_field(12, fields::per_depth::argmax_index), "depth12.argmax_index");
   EXPECT_EQ(std::string("front") + fields::per_camera::depth_mm, "front.depth_mm");
   EXPECT_EQ(fields::adam_prefix + fields::depth_prefix(1) + "conv.weight" + fields::per_parameter::exp_avg_sq,
