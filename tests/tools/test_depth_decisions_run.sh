@@ -147,6 +147,16 @@ echo "--no-such-option" > "$tmp/runs/reach_prism/qte-k3-t3-seed6/plan_options"
 err=$(timeout 300 bash "$src/examples/depths_of_runs.sh" "$tmp/runs" "$tmp/depths" 2>&1) && fail "a refused planner option passed"
 grep -q "failed for .*qte-k3-t3-seed6" <<<"$err" || fail "the failed run is not named: $err"
 [ "$(ls "$tmp/depths")" = reach_prism_qte-k3-t3-seed4.csv ] || fail "a failed run left $(ls "$tmp/depths")"
+# A table another pass is writing (two runs ending together, each make running this script over
+# one directory) is left to that pass: while its lock is held, this pass neither writes it nor
+# replays the run (whose refused option would stop it), and goes on.
+exec 8> "$tmp/depths/reach_prism_qte-k3-t3-seed6.csv.lock"
+flock 8
+timeout 60 bash "$src/examples/depths_of_runs.sh" "$tmp/runs" "$tmp/depths" 2>/dev/null 8>&- \
+  || fail "a pass beside another's lock did not go on"
+[ ! -f "$tmp/depths/reach_prism_qte-k3-t3-seed6.csv" ] || fail "a table under another pass's lock was written"
+exec 8>&-
+rm "$tmp/depths/reach_prism_qte-k3-t3-seed6.csv.lock"
 
 # --- a stream without objects is refused, naming the option -----------------------------------
 err=$($py "$src/examples/analysis/depth_decisions.py" "$src/tests/data/pick_and_lift_obs.rec" 2>&1); rc=$?
