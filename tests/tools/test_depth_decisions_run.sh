@@ -132,7 +132,7 @@ cmp -s "$tmp/direct.csv" "$tmp/depths/reach_prism_qte-k3-t3-seed4.csv" \
   || fail "depths_of_runs.sh's table is not the run's: $(cat "$tmp/depths/reach_prism_qte-k3-t3-seed4.csv")"
 # A run resumed past its end (learn.sh with a larger budget) snapshots a newer checkpoint than
 # its eval.csv: not finished until it writes eval.csv again, so no table.
-cp -r "$run" "$tmp/runs/reach_prism/qte-k3-t3-seed7"
+cp -rp "$run" "$tmp/runs/reach_prism/qte-k3-t3-seed7"
 touch -d '+1 second' "$tmp/runs/reach_prism/qte-k3-t3-seed7/eval/checkpoint.rec"
 bash "$src/examples/depths_of_runs.sh" "$tmp/runs" "$tmp/depths" 2>/dev/null || fail "depths_of_runs.sh with a resumed run"
 [ "$(ls "$tmp/depths")" = reach_prism_qte-k3-t3-seed4.csv ] || fail "a resumed run got a table: $(ls "$tmp/depths")"
@@ -142,7 +142,9 @@ bash "$src/examples/depths_of_runs.sh" "$tmp/runs" "$tmp/depths" 2>/dev/null \
   && [ "$(cat "$tmp/depths/reach_prism_qte-k3-t3-seed4.csv")" = kept ] || fail "a table already there was not kept"
 # The run's planner options reach plan-path: one it refuses stops the script, naming the run,
 # and leaves no table, whole or half-written.
-cp -r "$run" "$tmp/runs/reach_prism/qte-k3-t3-seed6"
+# -p: a copy keeps the run finished (its checkpoint not newer than its eval.csv, whatever order cp
+# writes them in)
+cp -rp "$run" "$tmp/runs/reach_prism/qte-k3-t3-seed6"
 echo "--no-such-option" > "$tmp/runs/reach_prism/qte-k3-t3-seed6/plan_options"
 err=$(timeout 300 bash "$src/examples/depths_of_runs.sh" "$tmp/runs" "$tmp/depths" 2>&1) && fail "a refused planner option passed"
 grep -q "failed for .*qte-k3-t3-seed6" <<<"$err" || fail "the failed run is not named: $err"
