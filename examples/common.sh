@@ -74,6 +74,22 @@ checkpoint_path() {  # DIR STEP
 # nothing in flight. The programs' names separate their arguments. The exit statuses of the
 # pipeline's programs, in order, are left in the array agent_loop_status (for a caller without
 # set -e).
+# write_once OUT COMMAND...: COMMAND's standard output to OUT, whole or not at all, by one pass
+# only: when OUT is there, or another pass holds OUT's lock (two runs ending together, each make
+# writing one directory's tables), nothing runs and the status is 0; a failed COMMAND leaves no
+# OUT and returns its failure.
+write_once() {
+  local out=$1 status=0
+  shift
+  exec 9> "$out.lock"
+  if flock -n 9 && [ ! -f "$out" ]; then
+    if "$@" > "$out.tmp"; then mv "$out.tmp" "$out"; else status=1; rm -f "$out.tmp"; fi
+    rm -f "$out.lock"
+  fi
+  exec 9>&-
+  return "$status"
+}
+
 agent_loop() {
   local back=(tee) fifo part=stage world=() select=() plan=()
   if [ "$1" = --only-trajectories-back ]; then back=(send_trajectories_back); shift; fi

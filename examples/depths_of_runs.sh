@@ -15,17 +15,9 @@ for run in "$1"/*/*-seed*/; do
   out=$2/${run_task}_$run_name.csv
   [ -f "$out" ] && continue
   echo "$(date +%T) depth decisions of $run_task $run_name: K ${run_k[*]}, $run_image, $run_episodes episodes" >&2
-  # Two passes over one directory (two runs ending together): each table is written by the
-  # pass that holds its lock; the other leaves it.
-  exec 9> "$out.lock"
-  if ! flock -n 9 || [ -f "$out" ]; then exec 9>&-; continue; fi
-  if ! PLAN_OPTIONS=$run_plan_options bash "$here/depth_decisions.sh" "$run_task" "$run/eval/checkpoint.rec" \
-      "${run_k[0]}" "$run_image" "$run_episodes" "$run_label" "${run_k[@]:1}" > "$out.tmp"; then
-    rm -f "$out.tmp" "$out.lock"
+  if ! PLAN_OPTIONS=$run_plan_options write_once "$out" bash "$here/depth_decisions.sh" "$run_task" "$run/eval/checkpoint.rec" \
+      "${run_k[0]}" "$run_image" "$run_episodes" "$run_label" "${run_k[@]:1}"; then
     echo "depths_of_runs.sh: depth_decisions.sh failed for $run" >&2
     exit 1
   fi
-  mv "$out.tmp" "$out"
-  rm -f "$out.lock"
-  exec 9>&-
 done

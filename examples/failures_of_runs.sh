@@ -15,17 +15,9 @@ for run in "$1"/takeaway*/*/*-seed*/; do
   [ -f "$run/failures.csv" ] || [ -f "$out" ] && continue
   echo "$takeaway $run_task $run_name: K ${run_k[*]}, $run_image, $run_episodes episodes" >&2
   mkdir -p "$(dirname "$out")"
-  # Two passes over one directory (two runs ending together): each table is written by the
-  # pass that holds its lock; the other leaves it.
-  exec 9> "$out.lock"
-  if ! flock -n 9 || [ -f "$out" ]; then exec 9>&-; continue; fi
-  if ! PLAN_OPTIONS=$run_plan_options bash "$here/failure_reasons.sh" "$run_task" "$run/eval/checkpoint.rec" \
-      "${run_k[0]}" "$run_image" "$run_episodes" "$run_label" "$run_seed" "${run_k[@]:1}" > "$out.tmp"; then
-    rm -f "$out.tmp" "$out.lock"
+  if ! PLAN_OPTIONS=$run_plan_options write_once "$out" bash "$here/failure_reasons.sh" "$run_task" "$run/eval/checkpoint.rec" \
+      "${run_k[0]}" "$run_image" "$run_episodes" "$run_label" "$run_seed" "${run_k[@]:1}"; then
     echo "failures_of_runs.sh: failure_reasons.sh failed for $run" >&2
     exit 1
   fi
-  mv "$out.tmp" "$out"
-  rm -f "$out.lock"
-  exec 9>&-
 done

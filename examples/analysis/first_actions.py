@@ -21,28 +21,22 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "lib", "python"))  # or installed: make install
-import qte_stream  # noqa: E402
-
-
-def text(value):
-    return value if isinstance(value, str) else bytes(value).decode()
+from qte_stream import read_records, scene_objects  # noqa: E402
 
 
 def agent_actions(path, step):
     """Per episode, (the objects' names, their positions, the action of `step`), in order: an
     action is paired with the observation it answers (the last one before it)."""
-    episodes, obs = [], None
-    for record in qte_stream.read_records(path):
-        f = record.fields
+    episodes, objects = [], None
+    for record in read_records(path):
         if record.type == "obs":
-            obs = f
-        elif record.type == "action" and int(f["step"]) == step:
-            if obs is None or "objects.pose" not in obs:
+            objects = scene_objects(record)
+        elif record.type == "action" and int(record.fields["step"]) == step:
+            if objects is None:
                 sys.exit(f"first_actions.py: {path}: an action with no observation with objects before it "
                          "(run sim-step with --objects)")
-            names = text(obs["objects.names"]).split(",") if text(obs["objects.names"]) else []
-            positions = np.asarray(obs["objects.pose"], dtype=float).reshape(-1, 7)[:, :3]
-            episodes.append((names, positions, f))
+            positions = np.array([o.pose[:3] for o in objects], dtype=float).reshape(-1, 3)
+            episodes.append(([o.name for o in objects], positions, record.fields))
     return episodes
 
 
@@ -50,7 +44,7 @@ def demonstrated(path, step):
     """Per demonstrated episode (in file order), its transition of `step` from the earliest
     frame: the keyframe a demonstration went to at that step."""
     chosen, order = {}, []
-    for record in qte_stream.read_records(path):
+    for record in read_records(path):
         f = record.fields
         if record.type != "transition" or int(f["demo"]) != 1 or int(f["step"]) != step:
             continue

@@ -111,10 +111,10 @@ namespace per_depth {
 QTE_DEPTH_FIELD_SUFFIXES(QTE_FIELD_CONSTANT)
 }
 
+inline std::string depth_field(int depth, const char* suffix) { return "depth" + std::to_string(depth) + suffix; }
 // "depth<d>." : the prefix of a depth's fields, network parameters included
 // ("depth0.conv1.weight"); the optimiser's state is under "adam." + depth_prefix(d).
-inline std::string depth_prefix(int depth) { return "depth" + std::to_string(depth) + "."; }
-inline std::string depth_field(int depth, const char* suffix) { return "depth" + std::to_string(depth) + suffix; }
+inline std::string depth_prefix(int depth) { return depth_field(depth, "."); }
 // Whether `name` is a depth's field or network parameter: "depth<digits>.…".
 inline bool is_per_depth(const std::string& name) {
   const std::size_t after = name.find_first_not_of("0123456789", 5);

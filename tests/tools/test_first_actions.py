@@ -24,8 +24,9 @@ def pack(path, rtype, *fields):
 def obs(path, step, objects=True):
     fields = [f"step:i32={step}"]
     if objects:
-        fields += ["objects.names=base,phone",
-                   "objects.pose:f64[2,7]=0,0,0.75,0,0,0,1,0.3,0,0.75,0,0,0,1"]
+        fields += ["objects.names=base,phone", "objects.role:u8=0,1",
+                   "objects.pose:f64[2,7]=0,0,0.75,0,0,0,1,0.3,0,0.75,0,0,0,1",
+                   "objects.box:f64[2,6]=-0.05,-0.09,-0.01,0.05,0.09,0.01,-0.04,-0.07,-0.005,0.04,0.07,0.005"]
     pack(path, "obs", *fields)
 
 
