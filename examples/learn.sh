@@ -239,7 +239,7 @@ if [ ! -f "$run/replay.rec" ]; then
     demo-record --task "$task" --episodes "$DEMOS" --seed "$SEED" --scenes demo --variation "$VARIATION" --image-size "$IMAGE" \
       --compress --output "$run/demos.rec" 2>> "$run/demos.log"
   fi
-  keyframe --seed "$SEED" $NET_OPTIONS --output "$run/replay.rec.tmp" "$run/demos.rec" 2>> "$run/demos.log"
+  keyframe --seed "$SEED" --chain-steps "$CHAIN_STEPS" $NET_OPTIONS --output "$run/replay.rec.tmp" "$run/demos.rec" 2>> "$run/demos.log"
   mv "$run/replay.rec.tmp" "$run/replay.rec"
   demos_ticks=$(( $(shell_ticks) - before ))
 fi

@@ -1,4 +1,5 @@
 // keyframe: demonstrations to replay transitions (keyframes, demo and crop augmentation).
+#include <array>
 #include <iostream>
 
 #include "cli/command.hpp"
@@ -23,7 +24,8 @@ static cli::Usage usage() {
       "stop in the 4 frames before, not the second-to-last frame); of two adjacent final "
       "keyframes the first is dropped.",
       "Besides the chain from the first frame, a chain starts at every --augment-every-th frame (demo "
-      "augmentation), each leading through the keyframes after it. A transition's action is its "
+      "augmentation), each leading through the keyframes after it, its steps (the time input) counted "
+      "as --chain-steps says. A transition's action is its "
       "next keyframe's gripper pose: the voxel index at every depth (depth d inside the grid "
       "centred on depth d-1's voxel, shifted by U(-0.75, 0.75) * offset per axis with crop "
       "augmentation), rotation bins (Euler 'xyz', 72 bins of 5 degrees), gripper open/close, "
@@ -45,6 +47,11 @@ static cli::Usage usage() {
   u.options = {
       cli::integer_option("augment-every", "N", "start a demo-augmentation chain at every N-th frame; 0 for none",
                           cli::default_text(keyframes::TransitionOptions{}.augmentation_every_n), 0, 100000),
+      {"chain-steps", "S",
+       "the step a demo-augmentation chain counts from, which sets its samples' time input: reset (each chain "
+       "from 0, as the published code) or episode (the keyframes at or before its first frame, as an agent "
+       "acting in that phase)",
+       "reset"},
       {"no-crop-augmentation", "", "use the unshifted centres for the deeper grids", ""},
       {"keep-failed", "", "also convert unsuccessful episodes (reward 0 throughout)", ""},
       {"not-demo", "", "mark the transitions as the agent's own, not demonstrations", ""},
@@ -67,6 +74,8 @@ static cli::Usage usage() {
 static void run(const cli::Arguments& args) {
   keyframes::TransitionOptions options;
   options.augmentation_every_n = static_cast<int>(args.integer("augment-every"));
+  options.chain_steps = std::array{keyframes::ChainSteps::reset,
+                                   keyframes::ChainSteps::episode}[args.choice("chain-steps", {"reset", "episode"})];
   options.hierarchy = voxels::parse_hierarchy(args);
   options.crop_augmentation = !args.flag("no-crop-augmentation");
   options.keep_failed = args.flag("keep-failed");

@@ -1,5 +1,6 @@
 #include "keyframes/transitions.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <set>
@@ -259,6 +260,8 @@ void EpisodeConverter::convert(std::vector<stream::Record>& episode, const strea
   };
   for (int start : starts) {
     int previous = start, step = 0;
+    if (options_.chain_steps == ChainSteps::episode)
+      step = static_cast<int>(std::count_if(keyframes.begin(), keyframes.end(), [&](int k) { return k <= start; }));
     for (int k : keyframes) {
       if (k <= start) continue;
       const stream::Record t = transition(episode, previous, k, step, episode_key, k == keyframes.back(), success);

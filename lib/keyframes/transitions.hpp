@@ -18,9 +18,17 @@
 
 namespace qte::keyframes {
 
+// The step a demo-augmentation chain counts from, and so the time input of its samples
+// (proprioception's time, 1 - 2 step / (episode length - 1)). `reset`, the published code's:
+// every chain from 0, so a chain started mid-episode is trained with the time of an episode's
+// first step. `episode`: from the number of keyframes at or before the chain's first frame,
+// the step an agent acting in that phase is at, so training and acting agree on time.
+enum class ChainSteps { reset, episode };
+
 struct TransitionOptions {
   voxels::CoarseToFine hierarchy;
   int augmentation_every_n = 10;  // 0: chains only from the first frame
+  ChainSteps chain_steps = ChainSteps::reset;
   bool crop_augmentation = true;
   double crop_shift_fraction = 0.75;  // of the offset, per axis, uniform
   double stopping_delta = 0.1;
