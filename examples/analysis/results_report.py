@@ -56,7 +56,8 @@ ABLATION_ALSO = ("qte-k10-t0", "qte-k10-t10")  # (label, baseline)
 ABLATION_PAIRED = "ablation_paired.csv"
 # Comparisons with another baseline than C2F-ARM that the summary makes outside takeaway 3, each
 # directory's written to a CSV of its own: {directory: (CSV, [(label, baseline)])}.
-OTHER_BASELINES = {"takeaway2-depths3": ("released_paired.csv", [("qte-k3-t0", "qte-k10-t10")])}
+OTHER_BASELINES = {"takeaway2-depths3": ("released_paired.csv", [("qte-k3-t0", "qte-k10-t10")]),
+                   "takeaway4": ("released_paired.csv", [("qte-k3-t0", "qte-k10-t10"), ("qte-k3-t0", "qte-k10-t0")])}
 NAMES = {"c2farm-k1-t0": "C2F-ARM", "qte-k10-t10": "QTE", "qte-k10-t0": "QTE acting only",
          "qte-k1-t1": "K = 1", "qte-k3-t0": "QTE as released"}
 # The summary: per takeaway, the paired comparisons that answer it: (takeaway, directory, CSV,
@@ -146,6 +147,12 @@ def ablation_paired(runs):
     return table
 
 
+def other_paired(name, runs):
+    """The directory's comparisons with another baseline than C2F-ARM (OTHER_BASELINES)."""
+    _, comparisons = OTHER_BASELINES[name]
+    return [row for label, baseline in comparisons for row in results_table.paired(runs, baseline) if row["label"] == label]
+
+
 def acting_paths(directory):
     failures = sorted(glob.glob(os.path.join(directory, "failures", "*.csv")))
     others = sorted(glob.glob(os.path.join(directory, "acting", "*.csv")))
@@ -161,11 +168,8 @@ def written(results):
             _, runs = runs_of(directory)
             files[os.path.join(directory, ABLATION_PAIRED)] = as_csv(ablation_paired(runs))
         if name in OTHER_BASELINES:
-            path, comparisons = OTHER_BASELINES[name]
             _, runs = runs_of(directory)
-            files[os.path.join(directory, path)] = as_csv(
-                [row for label, baseline in comparisons for row in results_table.paired(runs, baseline)
-                 if row["label"] == label])
+            files[os.path.join(directory, OTHER_BASELINES[name][0])] = as_csv(other_paired(name, runs))
         failures, others = acting_paths(directory)
         if others:
             files[os.path.join(directory, "acting.csv")] = as_csv(results_table.acting(failures + others))
@@ -367,6 +371,14 @@ def section(directory, images):
                        + see(directory, "paired.csv", "with each seed's difference and the pairs run on one processor")
                        + ":\n")
             out.append(markdown(paired_narrow(paired), columns))
+        other = other_paired(name, runs) if name in OTHER_BASELINES else []
+        if other:
+            out.append("\nThe same runs against another baseline than C2F-ARM, paired by seed"
+                       + see(directory, OTHER_BASELINES[name][0], "with each seed's difference and the pairs run on one "
+                             "processor", always=True) + ":\n")
+            out.append(markdown(paired_narrow(other), ["label", "baseline", "pairs", "mean_success",
+                                                       "baseline_mean_success", "mean_difference", "ci95",
+                                                       "sign_flip_p"]))
         if name == ABLATION:
             label, baseline = ABLATION_ALSO
             out.append(f"\nEach variant against greedy K = 1 (`{ABLATION_BASELINE}`), and `{label}` against `{baseline}`, "

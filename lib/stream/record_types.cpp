@@ -198,7 +198,7 @@ constexpr FieldSchema transition_fields[] = {
     {fields::next_frame, "int32", "[]", false,
      "the keyframe reached"},
     {fields::step, "int32", "[]", false,
-     "position of `frame` in its chain (0 for a chain's start); for the agent, the observation's `step`"},
+     "the step of `frame`: its position in its chain (0 for a chain's start), or with `keyframe --chain-steps episode` the keyframes at or before it; for the agent, the observation's `step`"},
     {fields::voxels, "int32", "[]", false,
      "voxels per side of the grids the indices refer to (`qattn-train` refuses others; optional in older files)"},
     {"depth<d>.index", "int32", "[3]", false,

@@ -260,3 +260,42 @@ TEST(Transitions, AGripperPoseWithoutARotationIsRefused) {
     }
   }
 }
+
+// The step each transition carries (its time input), both ways, against a count made here: with
+// `episode` a transition from frame f is at the step of the keyframes at or before f (where an
+// agent acting in that phase is), on every chain alike; with `reset` each chain starts at 0.
+TEST(Transitions, ChainStepsCountFromZeroOrFromTheKeyframesPassed) {
+  auto demo = synthetic_demo(35, 12);
+  demo[22].set<double>("joint_velocities", {7}, std::vector<double>(7, 0.05));  // a stop: keyframe 22
+  for (const ChainSteps chain_steps : {ChainSteps::reset, ChainSteps::episode}) {
+    TransitionOptions options;
+    options.chain_steps = chain_steps;
+    EpisodeConverter converter(options);
+    std::vector<stream::Record> transitions;
+    const stream::Emit keep = [&](const stream::Record& r) {
+      if (r.type() == "transition") transitions.push_back(r);
+    };
+    for (const auto& r : demo) converter.handle(r, keep);
+    converter.finish(keep);
+    std::set<int> keyframes;
+    for (const auto& t : transitions) keyframes.insert(t.scalar<int32_t>("next_frame"));
+    ASSERT_EQ(keyframes, (std::set<int>{12, 22, 34}));
+    ASSERT_EQ(transitions.size(), 3u + 3u + 2u + 1u);  // chains from frames 0, 10, 20 and 30
+    std::set<int> chain_starts_at_zero;
+    for (std::size_t i = 0; i < transitions.size(); ++i) {
+      const int from = transitions[i].scalar<int32_t>("frame"), step = transitions[i].scalar<int32_t>("step");
+      const bool chain_start = !keyframes.count(from);
+      int passed = 0;
+      for (int k : keyframes) passed += k <= from;
+      if (chain_steps == ChainSteps::episode) {
+        EXPECT_EQ(step, passed) << "transition from frame " << from;
+      } else if (chain_start) {
+        EXPECT_EQ(step, 0) << "chain from frame " << from;
+        chain_starts_at_zero.insert(from);
+      } else {
+        EXPECT_EQ(step, transitions[i - 1].scalar<int32_t>("step") + 1);
+      }
+    }
+    if (chain_steps == ChainSteps::reset) EXPECT_EQ(chain_starts_at_zero, (std::set<int>{0, 10, 20, 30}));
+  }
+}
