@@ -1,6 +1,5 @@
 #include "keyframes/transitions.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <set>
@@ -260,10 +259,11 @@ void EpisodeConverter::convert(std::vector<stream::Record>& episode, const strea
   };
   for (int start : starts) {
     int previous = start, step = 0;
-    if (options_.chain_steps == ChainSteps::episode)
-      step = static_cast<int>(std::count_if(keyframes.begin(), keyframes.end(), [&](int k) { return k <= start; }));
     for (int k : keyframes) {
-      if (k <= start) continue;
+      if (k <= start) {  // a keyframe the chain starts after: the agent's step there counts it
+        if (options_.chain_steps == ChainSteps::episode) ++step;
+        continue;
+      }
       const stream::Record t = transition(episode, previous, k, step, episode_key, k == keyframes.back(), success);
       store(previous);
       store(k);
