@@ -146,6 +146,16 @@ if [ -f "$run/plan_options" ]; then
 else
   echo "$PLAN_OPTIONS" > "$run/plan_options"
 fi
+# The settings its replay's demonstrations were made with likewise: replay.rec is made once, so
+# a run resumed with others (CHAIN_STEPS=episode into a reset run's directory, which has the same
+# label) would train on data it does not name.
+demo_settings="DEMOS=$DEMOS IMAGE=$IMAGE VARIATION=$VARIATION CHAIN_STEPS=$CHAIN_STEPS DEMOS_FROM=$DEMOS_FROM NET_OPTIONS=$NET_OPTIONS"
+if [ -f "$run/demo_settings" ]; then
+  [ "$(cat "$run/demo_settings")" = "$demo_settings" ] || {
+    echo "learn.sh: $run was started with $(cat "$run/demo_settings"), not $demo_settings" >&2; exit 2; }
+elif [ ! -f "$run/replay.rec" ]; then  # a run started before the file was kept: its settings are unknown
+  echo "$demo_settings" > "$run/demo_settings"
+fi
 # The processor the run ran on, a line (started_utc,model,vector_isa,cores) when a start finds
 # another than the last line names (a run resumed elsewhere): under CPU_BUDGET a faster
 # processor buys more learner steps, so comparisons pair runs made on one kind. Actors of a

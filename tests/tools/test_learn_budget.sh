@@ -93,6 +93,12 @@ awk "BEGIN { exit !($sum - $(column cpu_s) > -1.5 && $sum - $(column cpu_s) < 1.
 for role in demos pretrain learner actor; do
   awk "BEGIN { exit !($(column "cpu_${role}_s") > 0) }" || fail "no processor time for the role $role: $final"
 done
+# A resume with other demonstrations' settings than the run's replay was made with is refused,
+# naming both, before anything runs: its label would not tell the two apart.
+CHAIN_STEPS=episode bash "$learn" reach_target "$run" 2> "$tmp/other.log" && fail "a resume with CHAIN_STEPS=episode ran"
+grep -q "learn.sh: $run was started with DEMOS=2 IMAGE=48x48 VARIATION=0 CHAIN_STEPS=reset .*, not DEMOS=2 IMAGE=48x48 VARIATION=0 CHAIN_STEPS=episode" \
+  "$tmp/other.log" || fail "no line naming the run's settings: $(cat "$tmp/other.log")"
+[ "$(tail -1 "$run/eval.csv")" = "$final" ] || fail "the refused resume changed eval.csv"
 
 # 3. A learner alive but stuck (stopped here with SIGSTOP) while the actor waits for it stops
 # the run within STALL_SECONDS, with a line naming it; nothing of the run is left running.
