@@ -10,6 +10,7 @@
 #include "qattention/branching_options.hpp"
 #include "qattention/keyframe_stage.hpp"
 #include "qattention/select_stage.hpp"
+#include "robot/rotation_bins.hpp"
 #include "stream/reader.hpp"
 #include "stream/stage.hpp"
 #include "stream/writer.hpp"
@@ -72,13 +73,17 @@ static cli::Usage usage() {
       "expert acting open-loop: a reference for what this grid, planner and task allow, the "
       "ceiling of learning, though not a strict bound (a network acts closed-loop and may "
       "retry). The action's Q-values and value are 0 and its checkpoint_step is -1; the "
-      "network options (--k, exploration, --png, --reload) are refused.",
+      "network options (--k, exploration, --png, --reload) are refused. --rotation-offset X,Y,Z "
+      "adds X, Y and Z bins to every keyframe's rotation bins (wrapped around): the same "
+      "rotation error in every action, to measure how precisely a task needs its rotations "
+      "(the ceiling at 0,0,1 is that of a rotation head whose yaw is one bin off).",
   };
   u.arguments = {cli::input_file()};
   u.options = {
       {"checkpoint", "FILE",
        "the networks: a 'checkpoint' record as qattn-train writes it (required unless --keyframes)", ""},
       {"keyframes", "FILE", "act with FILE's demonstrated keyframes (keyframe's transitions) instead of networks", ""},
+      {"rotation-offset", "X,Y,Z", "with --keyframes: bins (5 degrees each) added to every keyframe's rotation bins", ""},
       {"k", "K",
        "voxels expanded per non-leaf grid; 1 is C2F-ARM's greedy choice; 'auto': as many as the "
        "node's Q volume asks for (--k-margin or --k-mass, at most --k-max)",
@@ -141,7 +146,18 @@ static void run_keyframes(const cli::Arguments& args) {
     if (args.has(option))
       throw UsageError(std::string("--keyframes acts without networks: leave out --") + option);
   const std::string path = args.text("keyframes");
-  qattention::KeyframeStage stage(qattention::demonstrated_keyframes(path), path, args.flag("ignore-collisions"));
+  Eigen::Vector3i offset = Eigen::Vector3i::Zero();
+  if (args.has("rotation-offset")) {
+    const std::vector<double> bins = args.reals("rotation-offset", 3);
+    for (int axis = 0; axis < 3; ++axis) {
+      if (bins[axis] != std::round(bins[axis]) || std::abs(bins[axis]) >= robot::kRotationBins)
+        throw UsageError("--rotation-offset: whole numbers of bins, each between -71 and 71 (got " +
+                         args.text("rotation-offset") + ")");
+      offset[axis] = static_cast<int>(bins[axis]);
+    }
+  }
+  qattention::KeyframeStage stage(qattention::demonstrated_keyframes(path), path, args.flag("ignore-collisions"),
+                                  offset);
   stream::RecordReader reader(args.input());
   stream::RecordWriter writer(args.text("output"));
   stream::run_stage(stage, reader, writer);
@@ -149,6 +165,7 @@ static void run_keyframes(const cli::Arguments& args) {
 
 static void run(const cli::Arguments& args) {
   if (args.has("keyframes")) return run_keyframes(args);
+  if (args.has("rotation-offset")) throw UsageError("--rotation-offset is for --keyframes (networks choose their own bins)");
   if (!args.has("checkpoint")) throw UsageError("--checkpoint FILE is required (or --keyframes FILE)");
   const std::string checkpoint = args.text("checkpoint");
   qattention::SelectOptions options;

@@ -2,14 +2,15 @@
 """Where an agent's actions of one step go: for every episode of an agent stream (sim-step
 --objects | qte-select | plan-path, as failure_reasons.sh runs it), the action of step STEP
 (0: the first), its horizontal distance to each of the scene's objects, the object it is
-nearest, and its gripper command. With --demonstrations REPLAY (keyframe's output for the same
+nearest and that object's yaw, the action's rotation bins and its gripper command. With --demonstrations REPLAY (keyframe's output for the same
 scenes, in the same order) also the demonstrated keyframe of that step: how far the agent's
 pose is from it, and whether depth 0's voxel, the rotation bins and the gripper agree.
 
 A diagnosis, not a score: it tells an agent that goes to the right object and fails there from
 one that goes somewhere else, and which step of the demonstrations it is imitating (an agent
 that goes to a later keyframe's place with a later keyframe's gripper has taken one phase of
-the task for another).
+the task for another); and whether its rotation follows the object's (a rotation head that
+gives one yaw bin whatever the object's yaw has not learned to read it).
 
 Usage: first_actions.py [--step N] [--demonstrations REPLAY.rec] AGENT.rec > table.csv
 A CSV row per episode, then on stderr a summary line. Run with Debian's python3 (NumPy)."""
@@ -36,8 +37,15 @@ def agent_actions(path, step):
                 sys.exit(f"first_actions.py: {path}: an action with no observation with objects before it "
                          "(run sim-step with --objects)")
             positions = np.array([o.pose[:3] for o in objects], dtype=float).reshape(-1, 3)
-            episodes.append(([o.name for o in objects], positions, record.fields))
+            yaws = [yaw_deg(o.pose[3:7]) for o in objects]
+            episodes.append(([o.name for o in objects], positions, yaws, record.fields))
     return episodes
+
+
+def yaw_deg(quaternion):
+    """The heading of a pose's x axis about the world's z, degrees in (-180, 180]."""
+    x, y, z, w = (float(v) for v in quaternion)
+    return float(np.degrees(np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))))
 
 
 def demonstrated(path, step):
@@ -57,11 +65,14 @@ def demonstrated(path, step):
 
 
 def rows(episodes, demos):
-    for i, (names, positions, action) in enumerate(episodes):
+    for i, (names, positions, yaws, action) in enumerate(episodes):
         pose = np.asarray(action["pose"], dtype=float)
         distances = [float(np.linalg.norm(pose[:2] - p[:2])) for p in positions]
+        nearest = int(np.argmin(distances)) if names else None
         row = {"episode": i,
-               "nearest": names[int(np.argmin(distances))] if names else "",
+               "nearest": names[nearest] if names else "",
+               "nearest_yaw_deg": f"{yaws[nearest]:+.0f}" if names else "",
+               "rotation_bins": " ".join(str(int(b)) for b in action["rotation_bins"]),
                "gripper_open": int(action["gripper_open"])}
         row.update({f"cm_to_{n}": f"{100 * d:.1f}" for n, d in zip(names, distances)})
         if demos is not None:
@@ -94,7 +105,9 @@ def main(argv=None):
     nearest = [row["nearest"] for row in table]
     counts = ", ".join(f"{n} {nearest.count(n)}" for n in dict.fromkeys(nearest))
     closed = sum(row["gripper_open"] == 0 for row in table)
-    print(f"step {args.step}: {len(table)} episodes; nearest object: {counts}; gripper closed in {closed}", file=sys.stderr)
+    yaw_bins = sorted({int(row["rotation_bins"].split()[2]) for row in table})
+    print(f"step {args.step}: {len(table)} episodes; nearest object: {counts}; gripper closed in {closed}; "
+          f"yaw bins {' '.join(map(str, yaw_bins))}", file=sys.stderr)
 
 
 if __name__ == "__main__":

@@ -6,6 +6,7 @@
 #include "common/error.hpp"
 #include "qattention/action_record.hpp"
 #include "replay/replay_buffer.hpp"
+#include "robot/rotation_bins.hpp"
 #include "stream/field_names.hpp"
 #include "stream/reader.hpp"
 #include "voxels/grid_fields.hpp"
@@ -74,8 +75,11 @@ std::vector<std::vector<Choice>> demonstrated_keyframes(const std::string& trans
 }
 
 KeyframeStage::KeyframeStage(std::vector<std::vector<Choice>> demonstrations, std::string source,
-                             bool ignore_collisions)
-    : demonstrations_(std::move(demonstrations)), source_(std::move(source)), ignore_collisions_(ignore_collisions) {}
+                             bool ignore_collisions, Eigen::Vector3i rotation_offset)
+    : demonstrations_(std::move(demonstrations)),
+      source_(std::move(source)),
+      ignore_collisions_(ignore_collisions),
+      rotation_offset_(std::move(rotation_offset)) {}
 
 void KeyframeStage::handle(const stream::Record& record, const stream::Emit& emit) {
   emit(record);
@@ -89,7 +93,10 @@ void KeyframeStage::handle(const stream::Record& record, const stream::Emit& emi
     record.fail(fields::step, "at most " + std::to_string(demonstrations_.size()) + " episodes: " + source_ +
                                   " holds " + std::to_string(demonstrations_.size()) + " demonstrations");
   const auto& keyframes = demonstrations_[episode_];
-  const Choice& a = keyframes[std::min<std::size_t>(step, keyframes.size() - 1)];
+  Choice a = keyframes[std::min<std::size_t>(step, keyframes.size() - 1)];
+  for (int axis = 0; axis < 3; ++axis)
+    a.rotation_bins[axis] = ((a.rotation_bins[axis] + rotation_offset_[axis]) % robot::kRotationBins + robot::kRotationBins) %
+                            robot::kRotationBins;
   emit(action_record(a, ignore_collisions_, 1, false, -1, step));
 }
 

@@ -28,7 +28,10 @@ std::vector<std::vector<Choice>> demonstrated_keyframes(const std::string& trans
 class KeyframeStage : public stream::Stage {
  public:
   // `ignore_collisions`: every action's, as qte-select --ignore-collisions sets it for networks.
-  KeyframeStage(std::vector<std::vector<Choice>> demonstrations, std::string source, bool ignore_collisions);
+  // `rotation_offset`: bins added to every keyframe's rotation bins (wrapped around), a
+  // rotation error of the same size in every action: how precise a task needs its rotations.
+  KeyframeStage(std::vector<std::vector<Choice>> demonstrations, std::string source, bool ignore_collisions,
+                Eigen::Vector3i rotation_offset = Eigen::Vector3i::Zero());
   void handle(const stream::Record& record, const stream::Emit& emit) override;
   std::vector<std::string> reads() const override { return {record_type::obs}; }
 
@@ -36,6 +39,7 @@ class KeyframeStage : public stream::Stage {
   std::vector<std::vector<Choice>> demonstrations_;
   std::string source_;
   bool ignore_collisions_;
+  Eigen::Vector3i rotation_offset_;
   int64_t episode_ = -1;
 };
 

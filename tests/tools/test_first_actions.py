@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """examples/analysis/first_actions.py on streams made with stream-pack, its table against values
 worked out here by hand: the action of the asked step per episode, its distance to each object,
-the nearest, the gripper; with --demonstrations, the earliest frame's demonstrated transition of
+the nearest and its yaw, the rotation bins, the gripper; with --demonstrations, the earliest frame's demonstrated transition of
 that step per episode key in file order; an agent stream without objects is refused."""
 import csv
 import io
@@ -25,7 +25,7 @@ def obs(path, step, objects=True):
     fields = [f"step:i32={step}"]
     if objects:
         fields += ["objects.names=base,phone", "objects.role:u8=0,1",
-                   "objects.pose:f64[2,7]=0,0,0.75,0,0,0,1,0.3,0,0.75,0,0,0,1",
+                   "objects.pose:f64[2,7]=0,0,0.75,0,0,0,1,0.3,0,0.75,0,0,0.5,0.8660254037844386",
                    "objects.box:f64[2,6]=-0.05,-0.09,-0.01,0.05,0.09,0.01,-0.04,-0.07,-0.005,0.04,0.07,0.005"]
     pack(path, "obs", *fields)
 
@@ -52,6 +52,7 @@ with tempfile.TemporaryDirectory() as tmp:
     obs(agent, 0); action(agent, 0, 0.01, 0.0, 0, d0="7,5,4")
     obs(agent, 1); action(agent, 1, 0.3, 0.0, 1)
     obs(agent, 0); action(agent, 0, 0.3, 0.02, 1, d0="9,9,4", bins="0,36,22")
+    # The phone is turned by +60 degrees (quaternion z = sin 30, w = cos 30), the base not.
     # Demonstrations: episode key 5 twice at step 0 (frames 4 and 0: frame 0 counts), key 9 once;
     # a step-1 transition of key 5 in between.
     transition(replay, 5, 4, 0, 0.5, 0, "0,0,0", "0,0,0")
@@ -66,16 +67,18 @@ with tempfile.TemporaryDirectory() as tmp:
         table = list(csv.DictReader(io.StringIO(r.stdout)))
         # Worked by hand: horizontal distances in cm; the demonstrated pose is (x, 0, 0.8).
         want = [
-            {"episode": "0", "nearest": "base", "gripper_open": "0", "cm_to_base": "1.0", "cm_to_phone": "29.0",
+            {"episode": "0", "nearest": "base", "nearest_yaw_deg": "+0", "rotation_bins": "0 36 20",
+             "gripper_open": "0", "cm_to_base": "1.0", "cm_to_phone": "29.0",
              "cm_to_demonstrated": "1.0", "depth0_agrees": "1", "rotation_agrees": "0",
              "demonstrated_gripper_open": "1"},
-            {"episode": "1", "nearest": "phone", "gripper_open": "1", "cm_to_base": "30.1", "cm_to_phone": "2.0",
+            {"episode": "1", "nearest": "phone", "nearest_yaw_deg": "+60", "rotation_bins": "0 36 22",
+             "gripper_open": "1", "cm_to_base": "30.1", "cm_to_phone": "2.0",
              "cm_to_demonstrated": "5.4", "depth0_agrees": "0", "rotation_agrees": "1",
              "demonstrated_gripper_open": "1"},
         ]
         if table != want:
             failures.append(f"table:\n{table}\nwanted:\n{want}")
-        if "nearest object: base 1, phone 1; gripper closed in 1" not in r.stderr:
+        if "nearest object: base 1, phone 1; gripper closed in 1; yaw bins 20 22" not in r.stderr:
             failures.append(f"summary: {r.stderr}")
 
     r = run("--step", "1", agent)

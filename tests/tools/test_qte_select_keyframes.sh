@@ -8,9 +8,12 @@
 # pose, turned by the keyframe's rotation bins (Euler xyz, 5 degrees, computed here); the
 # gripper command is the keyframe's; ignore_collisions is the agent's (--ignore-collisions),
 # never the expert's. The expert solves the scenes and so does its discretized self. On other
-# scenes, where the episodes outlast the keyframes, the last keyframe again. Errors: more
+# scenes, where the episodes outlast the keyframes, the last keyframe again. With
+# --rotation-offset, every action's bins are the keyframe's plus the offset, wrapped around, and
+# its pose turned by them. Errors: more
 # episodes than demonstrations, both --checkpoint and --keyframes, a network option, a file
-# without transitions: exit status and one line naming what is wrong.
+# without transitions, --rotation-offset with networks or out of range: exit status and one line
+# naming what is wrong.
 source "$(dirname "$0")/common.sh"
 src=${QTE_SOURCE:?set QTE_SOURCE to the repository}
 export PYTHONPATH="$src/lib/python"
@@ -27,6 +30,7 @@ loop() {  # SEED OUT [QTE-SELECT OPTIONS...]: 3 pick_and_lift scenes of seed SEE
 }
 loop 1000000 agent.rec
 loop 2000000 elsewhere.rec --ignore-collisions  # other scenes: the episodes outlast the keyframes
+loop 1000000 offset.rec --rotation-offset 0,-1,71  # 71 wraps a bin 0 keyframe's yaw round to 71
 
 $py - "$tmp/keyframes.rec" "$tmp" <<'PY' || fail "the keyframe actions"
 import math, os, sys
@@ -59,8 +63,9 @@ def matrix(q):  # x, y, z, w
                      [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
                      [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
 
-def check(name, ignore_collisions):
-    """Every action against its keyframe; (episodes, actions checked, actions past the last keyframe)."""
+def check(name, ignore_collisions, offset=(0, 0, 0)):
+    """Every action against its keyframe, turned by `offset` bins; (episodes, actions checked,
+    actions past the last keyframe)."""
     records = list(qte_stream.read_records(os.path.join(sys.argv[2], name)))
     episode, checked, past = -1, 0, 0
     for i, r in enumerate(records):
@@ -78,8 +83,9 @@ def check(name, ignore_collisions):
         voxel = bounds[3] / int(t["voxels"])
         centre = bounds[:3] + (index + 0.5) * voxel
         assert np.allclose(a["pose"][:3], centre, atol=1e-9), (name, episode, step, a["pose"][:3], centre)
-        assert np.allclose(matrix(a["pose"][3:]), rotation(t["rotation_bins"]), atol=1e-9), (name, episode, step)
-        assert a["gripper_open"] == t["gripper_open"] and list(a["rotation_bins"]) == list(t["rotation_bins"])
+        bins = [(int(b) + o) % 72 for b, o in zip(t["rotation_bins"], offset)]
+        assert np.allclose(matrix(a["pose"][3:]), rotation(bins), atol=1e-9), (name, episode, step)
+        assert a["gripper_open"] == t["gripper_open"] and list(a["rotation_bins"]) == bins, (name, episode, step)
         # the agent's flag, never the expert's (whose grasps are straight-line moves)
         assert a["ignore_collisions"] == ignore_collisions, (name, episode, step)
         assert a["checkpoint_step"] == -1 and a["value"] == 0 and a["depth0.q_value"] == 0
@@ -102,6 +108,8 @@ successes = sum(1 for r in qte_stream.read_records(os.path.join(sys.argv[2], "ag
 assert successes == 3, f"the discretized expert solved {successes} of 3 scenes"
 episodes_run, checked, past = check("elsewhere.rec", 1)
 assert episodes_run == 3 and past > 0, (episodes_run, checked, past)
+episodes_run, checked, _ = check("offset.rec", 0, (0, -1, 71))
+assert episodes_run == 3 and checked >= 9, (episodes_run, checked)
 PY
 
 # Errors: one line naming the file or option, exit status 1 (input) or 2 (usage).
@@ -115,7 +123,11 @@ qte-select --keyframes "$tmp/keyframes.rec" --checkpoint x.rec < /dev/null > /de
 [ $? = 2 ] && grep -q 'leave out --checkpoint' "$tmp/err" || fail "both agents: $(cat "$tmp/err")"
 qte-select --keyframes "$tmp/keyframes.rec" --epsilon 0.1 < /dev/null > /dev/null 2> "$tmp/err"
 [ $? = 2 ] && grep -q 'leave out --epsilon' "$tmp/err" || fail "exploration without networks: $(cat "$tmp/err")"
+qte-select --checkpoint x.rec --rotation-offset 0,0,1 < /dev/null > /dev/null 2> "$tmp/err"
+[ $? = 2 ] && grep -q 'rotation-offset is for --keyframes' "$tmp/err" || fail "an offset for networks: $(cat "$tmp/err")"
+qte-select --keyframes "$tmp/keyframes.rec" --rotation-offset 0,0,72 < /dev/null > /dev/null 2> "$tmp/err"
+[ $? = 2 ] && grep -q 'between -71 and 71 (got 0,0,72)' "$tmp/err" || fail "an offset of a full turn: $(cat "$tmp/err")"
 qte-select --keyframes "$tmp/experts.rec" < /dev/null > /dev/null 2> "$tmp/err" && fail "a file without transitions"
 grep -q "$tmp/experts.rec: no 'transition' records" "$tmp/err" || fail "no transitions: $(cat "$tmp/err")"
 qte-select < /dev/null > /dev/null 2> "$tmp/err"; [ $? = 2 ] || fail "no agent accepted"
-echo "qte-select --keyframes ok: the expert's discretized keyframes, step by step, solve its scenes; past its keyframes; errors"
+echo "qte-select --keyframes ok: the expert's discretized keyframes, step by step, solve its scenes; past its keyframes; a rotation offset; errors"
