@@ -9,11 +9,12 @@
 # Usage: ceiling.sh TASK OUT.csv   (the built programs on PATH; settings from the environment
 #        as learn.sh's: IMAGE 128x128, NET_OPTIONS (--depths, --offset), PLAN_OPTIONS, VARIATION,
 #        EVAL_SEED; EVAL_EPISODES 50; CEILING_LABEL keyframes; EXPERT_CACHE to keep the
-#        expert's recording). An existing OUT.csv is kept.
+#        expert's recording; CEILING_OPTIONS, qte-select's for the keyframes agent: e.g.
+#        "--rotation-offset 0,0,1", every action's yaw one bin off). An existing OUT.csv is kept.
 set -euo pipefail
 task=$1 out=$2
 [ ! -s "$out" ] || exit 0
 mkdir -p "$(dirname "$out")"
 bash "$(dirname "$0")/failure_reasons.sh" "$task" keyframes 1 "${IMAGE:-128x128}" "${EVAL_EPISODES:-50}" \
-  "${CEILING_LABEL:-keyframes}" > "$out.tmp"
+  "${CEILING_LABEL:-keyframes}" "" ${CEILING_OPTIONS:-} > "$out.tmp"
 mv "$out.tmp" "$out"
