@@ -80,6 +80,7 @@ def rows(episodes, demos):
             row["cm_to_demonstrated"] = f"{100 * np.linalg.norm(pose[:3] - np.asarray(d['target_pose'][:3])):.1f}"
             row["depth0_agrees"] = int(list(action["depth0.index"]) == list(d["depth0.index"]))
             row["rotation_agrees"] = int(list(action["rotation_bins"]) == list(d["rotation_bins"]))
+            row["demonstrated_rotation_bins"] = " ".join(str(int(b)) for b in d["rotation_bins"])
             row["demonstrated_gripper_open"] = int(d["gripper_open"])
         yield row
 

@@ -70,10 +70,12 @@ with tempfile.TemporaryDirectory() as tmp:
             {"episode": "0", "nearest": "base", "nearest_yaw_deg": "+0", "rotation_bins": "0 36 20",
              "gripper_open": "0", "cm_to_base": "1.0", "cm_to_phone": "29.0",
              "cm_to_demonstrated": "1.0", "depth0_agrees": "1", "rotation_agrees": "0",
+             "demonstrated_rotation_bins": "0 36 21",
              "demonstrated_gripper_open": "1"},
             {"episode": "1", "nearest": "phone", "nearest_yaw_deg": "+60", "rotation_bins": "0 36 22",
              "gripper_open": "1", "cm_to_base": "30.1", "cm_to_phone": "2.0",
              "cm_to_demonstrated": "5.4", "depth0_agrees": "0", "rotation_agrees": "1",
+             "demonstrated_rotation_bins": "0 36 22",
              "demonstrated_gripper_open": "1"},
         ]
         if table != want:
