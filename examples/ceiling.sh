@@ -15,6 +15,7 @@ set -euo pipefail
 task=$1 out=$2
 [ ! -s "$out" ] || exit 0
 mkdir -p "$(dirname "$out")"
+trap 'rm -f "$out.tmp"' EXIT  # a failed analysis leaves no half-written CSV
 bash "$(dirname "$0")/failure_reasons.sh" "$task" keyframes 1 "${IMAGE:-128x128}" "${EVAL_EPISODES:-50}" \
   "${CEILING_LABEL:-keyframes}" "" ${CEILING_OPTIONS:-} > "$out.tmp"
 mv "$out.tmp" "$out"

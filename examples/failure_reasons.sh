@@ -10,7 +10,8 @@
 #        acting open-loop, a reference for what this grid, planner and task allow. The scenes are learn.sh's evaluation scenes: VARIATION
 #        (0), EVAL_SEED (1000000) and PLAN_OPTIONS as there; SCENES=demo with EVAL_SEED and EPISODES a run's SEED and
 #        DEMOS acts on the scenes of its demonstrations instead (has the agent learned the scenes it was shown?).
-#        FAILURE_EPISODES=1: a line per episode on stderr.
+#        FAILURE_EPISODES=1: a line per episode on stderr. AGENT_STREAM=FILE keeps the agent's
+#        episodes (sim-step --objects | qte-select | plan-path) in FILE, for analysis/first_actions.py.
 # The expert's episodes of the scenes are recorded once per task, VARIATION, EVAL_SEED,
 # EPISODES, IMAGE and demo-record program (its checksum: a rebuilt expert records again) and
 # kept in EXPERT_CACHE, by default expert-cache/ beside the run directory (the checkpoint's
@@ -54,5 +55,6 @@ agent_loop "$tmp/loop" \
   sim-step "${scenes[@]}" --objects \
   qte-select "${agent[@]}" "$@" \
   plan-path ${PLAN_OPTIONS:-} > "$tmp/agent.rec"
+if [ -n "${AGENT_STREAM:-}" ]; then cp "$tmp/agent.rec" "$AGENT_STREAM.tmp" && mv "$AGENT_STREAM.tmp" "$AGENT_STREAM"; fi
 "$PYTHON" "$here/analysis/failure_reasons.py" --label "$label" --seed "$seed" ${FAILURE_EPISODES:+--episodes} \
   "$experts" "$tmp/agent.rec"

@@ -127,6 +127,15 @@ analyse 32x32 uncached.csv ""
 [ "$(calls)" = 3 ] || fail "EXPERT_CACHE= used the cache"
 cmp -s "$tmp/first.csv" "$tmp/uncached.csv" || fail "the analysis without the cache differs"
 analyse 32x32 elsewhere.csv "$tmp/elsewhere"
+# AGENT_STREAM keeps the agent's episodes: both scenes, to their terminal observations.
+AGENT_STREAM=$tmp/agent.rec analyse 32x32 kept.csv
+$py - "$tmp/agent.rec" <<'PY2' || fail "AGENT_STREAM: the agent's episodes"
+import sys
+import qte_stream
+records = list(qte_stream.read_records(sys.argv[1]))
+terminal = [r for r in records if r.type == "obs" and int(r.fields["terminal"])]
+assert len(terminal) == 2 and any(r.type == "action" for r in records), len(terminal)
+PY2
 [ "$(calls)" = 4 ] && [ -n "$(ls "$tmp/elsewhere")" ] || fail "EXPERT_CACHE=DIR was not recorded into"
 # reach_target needs no grasp (its expert holds nothing): closing the gripper there is no grasp_missed.
 $py -c "import csv, sys; row = list(csv.DictReader(open(sys.argv[1])))[0]; sys.exit(row['grasp_missed'] != '0')" \
@@ -141,7 +150,13 @@ tail -1 "$tmp/ceiling/reach_target_keyframes.csv" | grep -q "^keyframes,,2,2," \
   || fail "the ceiling on reach_target: $(cat "$tmp/ceiling/reach_target_keyframes.csv")"
 [ "$(calls)" = 5 ] && [ -z "$(ls -A "$tmp/cwd/sub")" ] && [ ! -e "$tmp/cwd/expert-cache" ] \
   && [ "$(ls "$tmp/ceiling")" = reach_target_keyframes.csv ] || fail "the ceiling's expert: $(calls) calls; $(ls -R "$tmp/cwd" "$tmp/ceiling")"
+# CEILING_OPTIONS reach the keyframes agent: an offset of a whole turn is refused, and no CSV.
+PATH="$tmp/bin:$PATH" IMAGE=32x32 EVAL_EPISODES=2 CEILING_OPTIONS="--rotation-offset 0,0,72" timeout 300 \
+  bash "$src/examples/ceiling.sh" reach_target "$tmp/ceiling/offset.csv" 2> "$tmp/offset.err" \
+  && fail "ceiling.sh with a refused CEILING_OPTIONS succeeded"
+grep -q 'between -71 and 71' "$tmp/offset.err" && [ -z "$(ls "$tmp/ceiling" | grep offset)" ] \
+  || fail "CEILING_OPTIONS did not reach qte-select: $(cat "$tmp/offset.err")"
 touch -d 2000-01-01 "$tmp/ceiling/reach_target_keyframes.csv"
 PATH="$tmp/bin:$PATH" bash "$src/examples/ceiling.sh" reach_target "$tmp/ceiling/reach_target_keyframes.csv" \
-  && [ "$(calls)" = 5 ] && [ "$(date -r "$tmp/ceiling/reach_target_keyframes.csv" +%Y)" = 2000 ] || fail "ceiling.sh redid an existing CSV"
+  && [ "$(calls)" = 6 ] && [ "$(date -r "$tmp/ceiling/reach_target_keyframes.csv" +%Y)" = 2000 ] || fail "ceiling.sh redid an existing CSV"
 echo "failure reasons ok: ${#reasons[@]} known episodes, the expert once per key, the ceiling"
