@@ -615,8 +615,8 @@ put(arm.spool, "motion-5-000000.xarm.csv", slow)
 if not arm.wait_call("reach"):
     failures.append(f"the slow first-row move did not start: {arm.calls()}")
 time.sleep(0.4)
+stopped_at = time.monotonic()  # before the request: the driver may act on it before we run again
 put(arm.spool, "stop", "")
-stopped_at = time.monotonic()
 status, err = arm.end()
 calls = arm.calls()
 halted = stop_time(calls)
@@ -632,8 +632,8 @@ put(arm.spool, "motion-6-000000.xarm.csv", reset.replace(reset.strip().splitline
 if not arm.wait_call("gripper 850"):
     failures.append(f"the gripper's slow move did not start: {arm.calls()}")
 time.sleep(0.4)
+stopped_at = time.monotonic()  # before the request: the driver may act on it before we run again
 put(arm.spool, "stop", "")
-stopped_at = time.monotonic()
 status, err = arm.end()
 calls = arm.calls()
 held = [c.split() for c in calls if c.startswith("gripper") and c != calls[0]]
@@ -650,8 +650,8 @@ put(arm.spool, "motion-7-000000.xarm.csv", slow)
 if not arm.wait_call("reach"):
     failures.append(f"the slow first-row move did not start: {arm.calls()}")
 time.sleep(0.4)
+signalled_at = time.monotonic()  # before the signal: the driver may stop the arm before we run again
 arm.process.send_signal(signal.SIGTERM)
-signalled_at = time.monotonic()
 status, err = arm.end()
 halted, stop_file = stop_time(arm.calls()) - signalled_at, os.path.join(arm.spool, "stop")
 if not 0 <= halted < 0.1 or status != 130 or arm.answered() or not os.path.exists(stop_file) \
