@@ -50,9 +50,10 @@ class PhoneOnBase : public Task {
   std::vector<Waypoint> expert_waypoints(const world::World& world) const override {
     const Eigen::Isometry3d phone = world.object_pose(world.object_id("phone"));
     const Eigen::Isometry3d base = world.object_pose(world.object_id("base"));
-    auto long_axis_yaw = [](const Eigen::Isometry3d& pose) {  // within +-90 degrees: the gripper is symmetric
-      return std::remainder(std::atan2(pose.linear()(1, 1), pose.linear()(0, 1)), M_PI);
-    };
+    // The long axis's own direction, 45..135 degrees for the boxes' yaws: folded into +-90 (the
+    // gripper is symmetric) the grasp's yaw would jump from +90 to -90 as the phone turns past 0,
+    // a rotation target no network can follow from a few demonstrations.
+    auto long_axis_yaw = [](const Eigen::Isometry3d& pose) { return std::atan2(pose.linear()(1, 1), pose.linear()(0, 1)); };
     auto waypoints = grasp_at(phone.translation(), long_axis_yaw(phone), 0.12);
     const auto place = place_at(base * Eigen::Vector3d(0, 0, (kBase.z() + kPhone.z()) / 2), long_axis_yaw(base), 0.1);
     waypoints.insert(waypoints.end(), place.begin(), place.end() - 1);  // no retreat: placed is done

@@ -184,6 +184,23 @@ TEST(PhoneOnBase, ThePhoneOnTheBaseNothingHeld) {
   EXPECT_FALSE(off.task->success(off.world));
 }
 
+// The expert's grasp and place follow the phone's and the base's long axes continuously: the
+// yaw is the axis's own direction (45..135 degrees for the scenes' +-45), never folded, so two
+// phones a degree apart on either side of 0 are grasped a degree apart, not 180 apart.
+TEST(PhoneOnBase, TheExpertsYawFollowsTheLongAxisWithoutAJump) {
+  for (uint64_t seed = 0; seed < 40; ++seed) {
+    TaskScene scene("phone_on_base", seed, 0);
+    const auto waypoints = scene.task->expert_waypoints(scene.world);
+    const double phone = tasks::yaw_of(scene.pose("phone")), base = tasks::yaw_of(scene.pose("base"));
+    for (std::size_t i = 0; i < waypoints.size(); ++i) {
+      const double yaw = tasks::yaw_of(waypoints[i].tcp_pose), object = i < 3 ? phone : base;
+      EXPECT_NEAR(yaw, object + M_PI / 2, 1e-9) << "seed " << seed << " waypoint " << i;
+      EXPECT_GE(yaw, M_PI / 4 - 1e-9) << "seed " << seed;
+      EXPECT_LE(yaw, 3 * M_PI / 4 + 1e-9) << "seed " << seed;
+    }
+  }
+}
+
 TEST(TakeUmbrellaOutOfUmbrellaStand, TheFootOutOfTheStand) {
   TaskScene scene("take_umbrella_out_of_umbrella_stand", 7, 0);
   const Eigen::Vector3d stand = scene.pose("umbrella_stand").translation();
