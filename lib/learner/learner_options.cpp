@@ -43,6 +43,10 @@ std::vector<cli::OptionSpec> learner_config_options() {
        default_text(d.tree_target_k)},
       cli::integer_option("n-step", "N", "bootstrap after N transitions of a chain, summing their discounted rewards",
                           default_text(d.n_step), 1, 10),
+      cli::real_option("demo-margin", "M",
+                       "DQfD's large-margin loss on the demonstrations: each head's demonstrated action's Q "
+                       "pushed M above every other's (0: none, as published)",
+                       default_text(d.demo_margin), 0, 1e3),
   };
 }
 
@@ -65,6 +69,7 @@ LearnerConfig learner_config_from(const cli::Arguments& args) {
   config.tree_branching = qattention::parse_branching(args, "tree-target", 0);
   config.tree_target_k = config.tree_branching.k;
   config.n_step = static_cast<int>(args.integer("n-step"));
+  config.demo_margin = args.real("demo-margin");
   config.validate();
   config.check_memory(static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE)));
   return config;

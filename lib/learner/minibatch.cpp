@@ -87,6 +87,7 @@ Minibatch assemble_minibatch(const replay::ReplayBuffer& replay, const replay::S
     const auto bins = t.array<int32_t>(fields::rotation_bins);
     for (int axis = 0; axis < 3; ++axis) b.rotation_bins.push_back(bins[axis]);
     b.gripper.push_back(t.scalar<uint8_t>(fields::gripper_open) != 0 ? 1 : 0);
+    b.demo.push_back(t.has(fields::demo) && t.scalar<uint8_t>(fields::demo) != 0 ? 1.0f : 0.0f);
     // The n-step return: rewards along the chain until it ends or n transitions are summed,
     // then the discounted value of the observation reached.
     std::size_t last = index;

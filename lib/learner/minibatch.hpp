@@ -21,6 +21,7 @@ struct Minibatch {
   std::vector<std::vector<int64_t>> voxel;  // per depth: the action's voxel, flat (x, y, z order)
   std::vector<int64_t> rotation_bins;       // [B, 3]
   std::vector<int64_t> gripper;             // [B]: 1 = open (the gripper head's index)
+  std::vector<float> demo;                  // [B]: 1 for a demonstration's transition, else 0
   std::vector<float> reward;                // as stored (100 on success); the discounted sum over n steps
   std::vector<float> discount;              // gamma^n, or 0 when the chain ends within n steps
   std::vector<std::shared_ptr<const voxels::ObservationCloud>> next_clouds;  // the replay's kept clouds

@@ -24,6 +24,13 @@ torch::Tensor longs(const std::vector<int64_t>& values, std::vector<int64_t> sha
   return torch::from_blob(const_cast<int64_t*>(values.data()), shape, torch::kInt64).clone();
 }
 
+// DQfD's large margin of each row of q [n, A]: max_a [q(a) + m [a != taken]] - q(taken), >= 0,
+// zero once the taken action (taken [n, 1]) leads every other by m.
+torch::Tensor large_margin(const torch::Tensor& q, const torch::Tensor& taken, double m) {
+  const auto margins = torch::full_like(q, m).scatter(1, taken, 0.0);
+  return (q + margins).amax(1) - q.gather(1, taken).squeeze(1);
+}
+
 }  // namespace
 
 struct QLearner::Torch {
@@ -95,20 +102,30 @@ StepStats QLearner::gradients(const Minibatch& batch) {
     const auto grid = torch::from_blob(const_cast<float*>(batch.grids[d].data()), {n, v, v, v, config_.net.channels});
     const nets::QOutputs out = torch_->online[d].module().forward(nets::channels_first(grid), proprio);
     const auto q = out.translation.reshape({n, -1});
-    const auto taken = q.gather(1, longs(batch.voxel[d], {n, 1})).squeeze(1);
+    const auto voxel = longs(batch.voxel[d], {n, 1});
+    const auto taken = q.gather(1, voxel).squeeze(1);
     const auto y = floats(targets.translation[d], {n});
     // Per sample: the TD loss (at the last depth one mean over translation, the three
     // rotation axes and the gripper) and lambda * mean|Q| (the translation volume; at the
     // last depth also the head's 3 x 72 + 2 outputs as one mean); both importance-weighted.
+    // With --demo-margin, a demonstration's sample adds its large margins, meant as the TD loss.
+    const double m = config_.demo_margin;
     auto per_sample = huber(taken, y);
+    auto margin = m > 0 ? large_margin(q, voxel, m) : torch::Tensor();
     auto regulariser = q.abs().mean(1);
     if (d + 1 == depths) {
-      const auto rotation = out.rotation.gather(2, longs(batch.rotation_bins, {n, 3, 1})).squeeze(2);
-      const auto gripper = out.gripper.gather(1, longs(batch.gripper, {n, 1})).squeeze(1);
+      const auto bins = longs(batch.rotation_bins, {n, 3, 1}), open = longs(batch.gripper, {n, 1});
+      const auto rotation = out.rotation.gather(2, bins).squeeze(2);
+      const auto gripper = out.gripper.gather(1, open).squeeze(1);
       per_sample = torch::cat({per_sample.unsqueeze(1), huber(rotation, floats(targets.rotation, {n, 3})),
                                huber(gripper, floats(targets.gripper, {n})).unsqueeze(1)}, 1).mean(1);
+      if (m > 0)
+        margin = torch::cat({margin.unsqueeze(1),
+                             large_margin(out.rotation.reshape({n * 3, -1}), bins.view({n * 3, 1}), m).view({n, 3}),
+                             large_margin(out.gripper, open, m).unsqueeze(1)}, 1).mean(1);
       regulariser = regulariser + torch::cat({out.rotation.reshape({n, -1}), out.gripper}, 1).abs().mean(1);
     }
+    if (m > 0) per_sample = per_sample + margin * floats(batch.demo, {n});
     const auto loss = ((per_sample + config_.q_regularisation * regulariser) * weights).mean();
     total = total + loss;
     const auto errors = (y - taken).abs().detach().contiguous();

@@ -24,6 +24,7 @@ std::string LearnerConfig::json() const {
     << ", \"grad_clip_value\": " << grad_clip_value << ", \"grad_clip_norm\": " << grad_clip_norm
     << ", \"q_regularisation\": " << q_regularisation << ", \"huber_delta\": " << huber_delta
     << ", \"tree_target_k\": " << tree_target_k << ", \"n_step\": " << n_step;
+  if (demo_margin > 0) s << ", \"demo_margin\": " << demo_margin;  // only then: older checkpoints still resume
   if (tree_branching.adaptive())  // only then: checkpoints from before adaptive K still resume
     s << ", \"tree_target\": \"" << qattention::describe(tree_branching) << "\"";
   s << "}";
@@ -46,6 +47,7 @@ void LearnerConfig::validate() const {
       {"q-reg", q_regularisation},
       {"huber-delta", huber_delta},
       {"n-step", static_cast<double>(n_step)},
+      {"demo-margin", demo_margin},
   };
   for (const auto& [name, value] : values) cli::check_range(options, name, value, "the learner's settings");
   if (tree_target_k < 0) throw Error("the learner's settings: tree_target_k must be >= 0, got " + std::to_string(tree_target_k));

@@ -29,6 +29,12 @@ struct LearnerConfig {
   // at most tree_target_k branches per node (qattention::Branching).
   qattention::Branching tree_branching;
   int n_step = 1;         // bootstrap after n transitions of a chain (the n-step return)
+  // DQfD's large-margin loss on the demonstrations' transitions, max_a [Q(a) + m [a != a_E]] -
+  // Q(a_E) per head (translation per depth; rotation axes and gripper), added to their TD loss:
+  // the demonstrated action's Q pushed m above every other's. 0: none, as published (C2F-ARM
+  // trains only the taken action's Q, so an output never demonstrated in a scene is never
+  // told it is worse there: docs/learner.md).
+  double demo_margin = 0;
 
   // The settings a resumed run must share with its checkpoint, as JSON.
   std::string json() const;

@@ -393,23 +393,26 @@ TEST(QLearner, GradientsAreClippedByValuePerDepth) {
 // error (at the last depth the mean of translation, three rotation axes and gripper) plus
 // lambda * (mean |translation Q| + at the last depth mean |the head's 218 outputs|), weighted
 // by the importance weights, then the batch mean.
-TEST(QLearner, LossIsOneMeanOverFiveTermsAndRegularisedWithImportanceWeights) {
-  learner::LearnerConfig config = small_config();
-  config.q_regularisation = 0.7;
-  Seeded s(config, 19);
-  learner::QLearner& learner = s.trainer;
-  learner::Minibatch& batch = s.batch;
-  batch.weights = {1.0, 0.5, 0.25, 0.75};
+// The loss of one step computed by hand from the networks' outputs, per depth: the Huber TD
+// loss of the taken action (at the last depth a mean over translation, three rotation axes and
+// the gripper), lambda * mean|Q|, and on a demonstration's sample the large margins
+// max_a [Q(a) + m [a != taken]] - Q(taken) by a loop over every action, meant like the TD loss.
+std::vector<double> loss_by_hand(learner::QLearner& learner, const learner::Minibatch& batch, double q_reg, double m) {
   const learner::Targets targets = learner.targets(batch);
-  const learner::StepStats stats = learner.gradients(batch);
   const int n = batch.size, cells = V * V * V;
-  double total = 0;
+  const auto margin = [&](const float* q, int count, int64_t taken) {
+    double most = -1e30;
+    for (int a = 0; a < count; ++a) most = std::max(most, q[a] + (a == taken ? 0.0 : m));
+    return most - q[taken];
+  };
+  std::vector<double> losses;
   for (int d = 0; d < 2; ++d) {
     const nets::QValues q = learner.online()[d].predict(batch.grids[d].data(), batch.proprio.data(), n);
     double loss = 0;
     for (int i = 0; i < n; ++i) {
       const float* t = q.translation.data() + static_cast<std::size_t>(i) * cells;
       double td = huber(t[batch.voxel[d][i]] - targets.translation[d][i]);
+      double margins = margin(t, cells, batch.voxel[d][i]);
       double reg = 0;
       for (int c = 0; c < cells; ++c) reg += std::abs(t[c]) / cells;
       if (d == 1) {
@@ -417,18 +420,54 @@ TEST(QLearner, LossIsOneMeanOverFiveTermsAndRegularisedWithImportanceWeights) {
         for (int axis = 0; axis < 3; ++axis) {
           const float* r = q.rotation.data() + (static_cast<std::size_t>(i) * 3 + axis) * 72;
           td += huber(r[batch.rotation_bins[3 * i + axis]] - targets.rotation[3 * i + axis]);
+          margins += margin(r, 72, batch.rotation_bins[3 * i + axis]);
           for (int b = 0; b < 72; ++b) head_reg += std::abs(r[b]) / 218;
         }
         const float* g = q.gripper.data() + static_cast<std::size_t>(i) * 2;
         td += huber(g[batch.gripper[i]] - targets.gripper[i]);
+        margins += margin(g, 2, batch.gripper[i]);
         head_reg += (std::abs(g[0]) + std::abs(g[1])) / 218;
         td /= 5;
+        margins /= 5;
         reg += head_reg;
       }
-      loss += batch.weights[i] * (td + 0.7 * reg) / n;
+      const double demo_margins = m > 0 && batch.demo[i] != 0 ? margins : 0.0;
+      loss += batch.weights[i] * (td + demo_margins + q_reg * reg) / n;
     }
-    EXPECT_NEAR(stats.depth_loss[d], loss, 1e-5 * std::abs(loss) + 1e-7) << "depth " << d;
-    total += loss;
+    losses.push_back(loss);
   }
-  EXPECT_NEAR(stats.loss, total, 1e-5 * std::abs(total));
+  return losses;
+}
+
+TEST(QLearner, LossIsOneMeanOverFiveTermsAndRegularisedWithImportanceWeights) {
+  learner::LearnerConfig config = small_config();
+  config.q_regularisation = 0.7;
+  Seeded s(config, 19);
+  s.batch.weights = {1.0, 0.5, 0.25, 0.75};
+  const std::vector<double> expected = loss_by_hand(s.trainer, s.batch, 0.7, 0);
+  const learner::StepStats stats = s.trainer.gradients(s.batch);
+  for (int d = 0; d < 2; ++d)
+    EXPECT_NEAR(stats.depth_loss[d], expected[d], 1e-5 * std::abs(expected[d]) + 1e-7) << "depth " << d;
+  EXPECT_NEAR(stats.loss, expected[0] + expected[1], 1e-5 * std::abs(expected[0] + expected[1]));
+}
+
+// --demo-margin: DQfD's large margins on the demonstrations' samples only; the margin is large
+// enough that the untrained networks' other actions are within it, so every head adds a term.
+TEST(QLearner, DemoMarginAddsTheLargeMarginsOfTheDemonstrationsOnly) {
+  learner::LearnerConfig config = small_config();
+  config.demo_margin = 0.4;
+  Seeded s(config, 19);
+  ASSERT_EQ(s.batch.size, 4);
+  s.batch.demo = {1, 0, 1, 0};  // the tiny replay's own flags aside: two of each
+  s.batch.weights = {1.0, 0.5, 0.25, 0.75};
+  const std::vector<double> with = loss_by_hand(s.trainer, s.batch, 1.0, 0.4);
+  const std::vector<double> without = loss_by_hand(s.trainer, s.batch, 1.0, 0);
+  const learner::StepStats stats = s.trainer.gradients(s.batch);
+  for (int d = 0; d < 2; ++d) {
+    EXPECT_NEAR(stats.depth_loss[d], with[d], 1e-5 * std::abs(with[d]) + 1e-7) << "depth " << d;
+    EXPECT_GT(with[d], without[d] + 0.01) << "depth " << d;  // the margins are there to be learned
+  }
+  // Not a setting older checkpoints lack: the JSON names it only when it is used.
+  EXPECT_NE(config.json().find("\"demo_margin\": 0.4"), std::string::npos);
+  EXPECT_EQ(small_config().json().find("demo_margin"), std::string::npos);
 }
