@@ -78,6 +78,37 @@ TEST(World, ObjectBoxesAreTheShapesOwnBoundsInTheObjectFrame) {
   expect_box("compound", {-0.01, -0.01, 0}, {0.11, 0.01, 0.06});
 }
 
+// The fingers close on what lies between their 2 cm pads: a 7 x 14 cm phone turned 20 degrees
+// to the jaws is 8.2 cm across the pads (its whole length would span 11.4 cm of the closing
+// axis) and fits the 85 mm stroke; turned 35 degrees it is 9.9 cm across and does not. An
+// object that fits is held with the fingers at its width across the pads.
+TEST(World, TheFingersCloseOnWhatLiesBetweenTheirPads) {
+  const auto width_across_pads = [](double yaw) {  // the phone's 3.5 cm half width, the pads' 1 cm half width
+    return 2 * (0.035 / std::cos(yaw) + 0.01 * std::tan(yaw));
+  };
+  for (double degrees : {0.0, 10.0, 20.0, 35.0}) {
+    SCOPED_TRACE(std::to_string(degrees) + " degrees");
+    world::World world(test_support::xarm());
+    const double table = world.layout().table_height_m, yaw = degrees * M_PI / 180;
+    world::ObjectSpec phone;
+    phone.name = "phone";
+    phone.size = Eigen::Vector3d(0.07, 0.14, 0.01);  // grasped across its width, x
+    phone.pose.linear() = Eigen::AngleAxisd(M_PI / 2 + yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    phone.pose.translation() << 0.15, 0.0, table + 0.005;
+    phone.mass_kg = 0.15;
+    const int id = world.add_object(phone);
+    Eigen::Isometry3d tcp = Eigen::Isometry3d::Identity();
+    tcp.linear() = tasks::top_down(0);  // closing along world y, the phone's width turned from it by yaw
+    tcp.translation() << 0.15, 0.0, table + 0.005;
+    world.set_robot_state(test_support::ik_world(world, tcp), 0.085);
+    const bool fits = width_across_pads(yaw) <= 0.085 + 0.004;
+    EXPECT_EQ(world.close_gripper(), fits ? id : -1);
+    if (fits) {
+      EXPECT_NEAR(world.finger_opening_m(), width_across_pads(yaw), 0.002);
+    }
+  }
+}
+
 namespace {
 
 // A 4 cm box held from above at its centre, 10 cm over a static slab whose top is at `slab_top`.
