@@ -377,7 +377,8 @@ std::optional<std::pair<double, double>> closing_extent(const Eigen::Isometry3d&
 int World::close_gripper() {
   gripper_open_ = false;
   if (held_ >= 0) return held_;
-  // Look for a graspable object whose centre lies between the fingers and that fits.
+  // Look for the graspable object nearest the TCP that the pads meet, more than 2 mm of it (the
+  // planner's "holding"), and that fits between the fingers.
   const Eigen::Isometry3d tcp = tcp_pose();
   const double finger_length = 0.055, finger_width = 0.02;
   int best = -1;
@@ -400,7 +401,8 @@ int World::close_gripper() {
     const double half_y = (in_tcp.linear().row(1).cwiseAbs()) * half;
     const Eigen::Vector3d c = in_tcp.translation();
     const auto across = closing_extent(in_tcp, half, finger_width / 2);  // what the pads meet
-    const bool between = across && std::max(-across->first, across->second) <= opening_m_ / 2 + 0.002 &&
+    const bool between = across && across->second - across->first > 0.002 &&
+                         std::max(-across->first, across->second) <= opening_m_ / 2 + 0.002 &&
                          c.z() >= -finger_length - 0.01 && c.z() <= 0.01 + half_y;
     if (between && c.norm() < best_distance) {
       best = id;

@@ -109,6 +109,40 @@ TEST(World, TheFingersCloseOnWhatLiesBetweenTheirPads) {
   }
 }
 
+// Beside the pads' band, or with only a corner of it in the band (no more than 2 mm across),
+// nothing is held; an object off the jaws' centre is held while all of it lies within the stroke.
+TEST(World, NothingIsHeldThatThePadsDoNotMeet) {
+  struct Case {
+    const char* what;
+    double yaw_deg, x, y;  // the 4 cm cube's yaw and offset from the TCP, along and across the pads
+    bool held;
+  };
+  const Case cases[] = {
+      {"beside the band", 0, 0.032, 0, false},  // 1.2 cm past the pads' edge
+      {"a corner's tip in the band", 45, 0.0375, 0, false},  // 0.8 mm of its corner: 1.6 mm across
+      {"well in the band at 45 degrees", 45, 0.015, 0, true},
+      {"off centre, within the stroke", 0, 0, 0.02, true},   // 4.0 to 0 cm from the centre line
+      {"off centre, past the stroke", 0, 0, 0.03, false},    // its far side 5 cm out: past 4.45
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    world::World world(test_support::xarm());
+    const double table = world.layout().table_height_m;
+    world::ObjectSpec cube;
+    cube.name = "cube";
+    cube.size = Eigen::Vector3d(0.04, 0.04, 0.04);
+    cube.pose.linear() = Eigen::AngleAxisd(c.yaw_deg * M_PI / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    cube.pose.translation() << 0.15, 0.0, table + 0.02;
+    cube.mass_kg = 0.1;
+    const int id = world.add_object(cube);
+    Eigen::Isometry3d tcp = Eigen::Isometry3d::Identity();
+    tcp.linear() = tasks::top_down(0);  // TCP x along world x, TCP y along world -y
+    tcp.translation() << 0.15 - c.x, c.y, table + 0.02;
+    world.set_robot_state(test_support::ik_world(world, tcp), 0.085);
+    EXPECT_EQ(world.close_gripper(), c.held ? id : -1);
+  }
+}
+
 namespace {
 
 // A 4 cm box held from above at its centre, 10 cm over a static slab whose top is at `slab_top`.
