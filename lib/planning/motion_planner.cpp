@@ -72,7 +72,7 @@ StartState start_state_from(const stream::Record& obs) {
     start.joints[k] = q[k];
   }
   start.opening_m = obs.scalar<double>(fields::gripper_opening_m);
-  start.holding = obs.scalar<uint8_t>(fields::gripper_open) == 0 && start.opening_m > 0.002;
+  start.holding = obs.scalar<uint8_t>(fields::gripper_open) == 0 && start.opening_m > robot::kHoldingOpening_m;
   return start;
 }
 

@@ -9,6 +9,9 @@
 namespace qte::robot {
 
 constexpr int kArmJoints = 7;
+// Fingers closed and stopped further apart than this hold something (on nothing they close
+// fully): what the simulator needs across the pads to grasp, and what the planner reads as held.
+constexpr double kHoldingOpening_m = 0.002;
 using JointVector = Eigen::Matrix<double, kArmJoints, 1>;
 
 struct Shape {

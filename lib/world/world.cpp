@@ -3,6 +3,7 @@
 #include <btBulletDynamicsCommon.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -350,9 +351,9 @@ namespace {
 // cross the planes.
 std::optional<std::pair<double, double>> closing_extent(const Eigen::Isometry3d& in_tcp, const Eigen::Vector3d& half,
                                                         double half_band) {
-  std::vector<Eigen::Vector3d> corners;
+  std::array<Eigen::Vector3d, 8> corners;
   for (int i = 0; i < 8; ++i)
-    corners.push_back(in_tcp * Eigen::Vector3d((i & 1 ? 1 : -1) * half.x(), (i & 2 ? 1 : -1) * half.y(), (i & 4 ? 1 : -1) * half.z()));
+    corners[i] = in_tcp * Eigen::Vector3d((i & 1 ? 1 : -1) * half.x(), (i & 2 ? 1 : -1) * half.y(), (i & 4 ? 1 : -1) * half.z());
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   const auto take = [&](const Eigen::Vector3d& p) {
     lo = std::min(lo, p.y());
@@ -377,8 +378,8 @@ std::optional<std::pair<double, double>> closing_extent(const Eigen::Isometry3d&
 int World::close_gripper() {
   gripper_open_ = false;
   if (held_ >= 0) return held_;
-  // Look for the graspable object nearest the TCP that the pads meet, more than 2 mm of it (the
-  // planner's "holding"), and that fits between the fingers.
+  // Look for the graspable object nearest the TCP that the pads meet (more of it than
+  // robot::kHoldingOpening_m across) and that fits between the fingers.
   const Eigen::Isometry3d tcp = tcp_pose();
   const double finger_length = 0.055, finger_width = 0.02;
   int best = -1;
@@ -401,7 +402,7 @@ int World::close_gripper() {
     const double half_y = (in_tcp.linear().row(1).cwiseAbs()) * half;
     const Eigen::Vector3d c = in_tcp.translation();
     const auto across = closing_extent(in_tcp, half, finger_width / 2);  // what the pads meet
-    const bool between = across && across->second - across->first > 0.002 &&
+    const bool between = across && across->second - across->first > robot::kHoldingOpening_m &&
                          std::max(-across->first, across->second) <= opening_m_ / 2 + 0.002 &&
                          c.z() >= -finger_length - 0.01 && c.z() <= 0.01 + half_y;
     if (between && c.norm() < best_distance) {
