@@ -22,6 +22,11 @@ std::vector<cli::OptionSpec> learner_config_options() {
   return {
       {"architecture", "A", "network per depth: light or arm", nets::architecture_name(d.net.architecture)},
       cli::integer_option("base-channels", "C", "first-level kernels (default: light 16, arm 64)", "", 1, 512),
+      {"head-input", "I",
+       "what the last depth's rotation and gripper head reads: pooled (every U-Net level pooled over the grid, as "
+       "published) or voxel (also the finest level's features at the voxel taken; light only; our variation, "
+       "docs/design.md)",
+       nets::head_input_name(d.net.head_input)},
       cli::integer_option("batch", "B", "transitions per step (published: 128)", default_text(d.batch), 1, 100000),
       cli::real_option("gamma", "G", "discount", default_text(d.gamma), 0, 1),
       cli::real_option("reward-scale", "F", "reward multiplier in the target", default_text(d.reward_scale), 1e-9, 1e9),
@@ -55,6 +60,7 @@ LearnerConfig learner_config_from(const cli::Arguments& args) {
   config.net.architecture = nets::architecture_from_name(args.text("architecture"));
   config.net.base_channels = args.has("base-channels") ? static_cast<int>(args.integer("base-channels"))
                                                        : nets::default_base_channels(config.net.architecture);
+  config.net.head_input = nets::head_input_from_name(args.text("head-input"));
   config.hierarchy = voxels::parse_hierarchy(args, 4, 128);  // the networks' smallest and largest grids
   config.batch = static_cast<int>(args.integer("batch"));
   config.gamma = args.real("gamma");

@@ -100,9 +100,9 @@ StepStats QLearner::gradients(const Minibatch& batch) {
   torch::Tensor total = torch::zeros({});
   for (int d = 0; d < depths; ++d) {
     const auto grid = torch::from_blob(const_cast<float*>(batch.grids[d].data()), {n, v, v, v, config_.net.channels});
-    const nets::QOutputs out = torch_->online[d].module().forward(nets::channels_first(grid), proprio);
-    const auto q = out.translation.reshape({n, -1});
     const auto voxel = longs(batch.voxel[d], {n, 1});
+    const nets::QOutputs out = torch_->online[d].module().forward(nets::channels_first(grid), proprio, voxel.view({n}));
+    const auto q = out.translation.reshape({n, -1});
     const auto taken = q.gather(1, voxel).squeeze(1);
     const auto y = floats(targets.translation[d], {n});
     // Per sample: the TD loss (at the last depth one mean over translation, the three

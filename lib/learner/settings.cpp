@@ -25,6 +25,8 @@ std::string LearnerConfig::json() const {
     << ", \"q_regularisation\": " << q_regularisation << ", \"huber_delta\": " << huber_delta
     << ", \"tree_target_k\": " << tree_target_k << ", \"n_step\": " << n_step;
   if (demo_margin > 0) s << ", \"demo_margin\": " << demo_margin;  // only then: older checkpoints still resume
+  if (net.head_input != nets::HeadInput::pooled)  // only then, likewise
+    s << ", \"head_input\": \"" << nets::head_input_name(net.head_input) << "\"";
   if (tree_branching.adaptive())  // only then: checkpoints from before adaptive K still resume
     s << ", \"tree_target\": \"" << qattention::describe(tree_branching) << "\"";
   s << "}";
@@ -50,6 +52,8 @@ void LearnerConfig::validate() const {
       {"demo-margin", demo_margin},
   };
   for (const auto& [name, value] : values) cli::check_range(options, name, value, "the learner's settings");
+  if (net.head_input == nets::HeadInput::voxel && net.architecture != nets::Architecture::light)
+    throw UsageError("--head-input voxel is built for --architecture light only");
   if (tree_target_k < 0) throw Error("the learner's settings: tree_target_k must be >= 0, got " + std::to_string(tree_target_k));
   cli::check_range(voxels::hierarchy_options(), "depths", hierarchy.depths, "the learner's settings");
   try {

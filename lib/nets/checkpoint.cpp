@@ -37,7 +37,9 @@ std::string config_json(const CheckpointConfig& c) {
   return std::string("{\"architecture\": \"") + architecture_name(c.net.architecture) +
          "\", \"base_channels\": " + std::to_string(c.net.base_channels) +
          ", \"voxels\": " + std::to_string(c.net.voxels) + ", \"channels\": " + std::to_string(c.net.channels) +
-         ", \"proprio\": " + std::to_string(c.net.proprio) + ", \"depths\": " + std::to_string(c.depths) + "}";
+         ", \"proprio\": " + std::to_string(c.net.proprio) + ", \"depths\": " + std::to_string(c.depths) +
+         (c.net.head_input == HeadInput::pooled ? "" : ", \"head_input\": \"" + std::string(head_input_name(c.net.head_input)) + "\"") +
+         "}";
 }
 
 // The config every network of the stack shares; refuses stacks that are not one per depth.
@@ -48,7 +50,7 @@ CheckpointConfig stack_config(const std::vector<QAttentionNet>& nets) {
     const NetConfig& c = nets[d].config();
     const bool same = c.architecture == config.net.architecture && c.base_channels == config.net.base_channels &&
                       c.voxels == config.net.voxels && c.channels == config.net.channels &&
-                      c.proprio == config.net.proprio;
+                      c.proprio == config.net.proprio && c.head_input == config.net.head_input;
     if (!same || c.depth != static_cast<int>(d) || c.is_last != (d + 1 == nets.size()))
       throw Error("checkpoint: network " + std::to_string(d) + " is not depth " + std::to_string(d) +
                   " of the same stack (one network per depth, same settings, the last one is_last)");
@@ -74,6 +76,9 @@ stream::Record checkpoint_record(const std::vector<QAttentionNet>& nets, const t
   stream::Record record(record_type::checkpoint);
   record.set_string(fields::architecture, architecture_name(config.net.architecture));
   record.set_scalar<int64_t>(fields::base_channels, config.net.base_channels);
+  // Written only when it is not the published input: other checkpoints keep their bytes.
+  if (config.net.head_input != HeadInput::pooled)
+    record.set_string(fields::head_input, head_input_name(config.net.head_input));
   record.set_scalar<int64_t>(fields::voxels, config.net.voxels);
   record.set_scalar<int64_t>(fields::channels, config.net.channels);
   record.set_scalar<int64_t>(fields::proprio, config.net.proprio);
@@ -125,6 +130,12 @@ CheckpointConfig checkpoint_config(const stream::Record& record) {
     throw StreamError(record.position, "'checkpoint' record: unknown architecture '" + architecture + "'");
   config.net.architecture = architecture_from_name(architecture);
   config.net.base_channels = integer(fields::base_channels, 1, 512);
+  if (record.has(fields::head_input)) {
+    const std::string input = record.string(fields::head_input);
+    if (input != "pooled" && input != "voxel")
+      record.fail(fields::head_input, "pooled or voxel, got '" + input + "'");
+    config.net.head_input = head_input_from_name(input);
+  }
   config.net.voxels = integer(fields::voxels, 4, 128);
   config.net.channels = integer(fields::channels, 1, 64);
   config.net.proprio = integer(fields::proprio, 1, 64);

@@ -83,12 +83,23 @@ torch::Tensor soft_argmax(const torch::Tensor& t) {
   return torch::cat({x, y, z}, 1);
 }
 
-// The dense head's input: per level, the max over voxels then the soft-argmax position.
+// The dense head's input: per level, the max over voxels then the soft-argmax position; then
+// the chosen voxel's features as they are (Trunk::levels' [B, C] entry, with HeadInput::voxel).
 torch::Tensor pooled_features(const std::vector<torch::Tensor>& levels) {
   std::vector<torch::Tensor> features;
-  for (const auto& t : levels) features.push_back(t.amax({2, 3, 4}));
-  for (const auto& t : levels) features.push_back(soft_argmax(t));
+  for (const auto& t : levels)
+    if (t.dim() == 5) features.push_back(t.amax({2, 3, 4}));
+  for (const auto& t : levels)
+    if (t.dim() == 5) features.push_back(soft_argmax(t));
+  for (const auto& t : levels)
+    if (t.dim() == 2) features.push_back(t);
   return torch::cat(features, 1);
+}
+
+// The features [B, C] of `finest` ([B, C, V, V, V]) at each sample's voxel ([B] flat indices).
+torch::Tensor features_at(const torch::Tensor& finest, const torch::Tensor& voxel) {
+  const int64_t b = finest.size(0), c = finest.size(1);
+  return finest.reshape({b, c, -1}).gather(2, voxel.view({b, 1, 1}).expand({b, c, 1})).squeeze(2);
 }
 
 Sequential dense_head(int features) {
@@ -223,7 +234,8 @@ class LightNet : public QAttentionModule {
     lateral1 = register_module("lateral1", conv1(2 * k, k));
     up0 = register_module("up0", conv3(k, k));
     q = register_module("q", conv1(k, 1));
-    if (config.is_last) head = register_module("head", dense_head(4 * (k + 2 * k + 4 * k + k)));
+    const int voxel_features = config.head_input == HeadInput::voxel ? k : 0;
+    if (config.is_last) head = register_module("head", dense_head(4 * (k + 2 * k + 4 * k + k) + voxel_features));
   }
 
   Trunk trunk_batch(const torch::Tensor& grid, const torch::Tensor& proprio_in) override {
@@ -278,19 +290,30 @@ class LightNet : public QAttentionModule {
 
 }  // namespace
 
-QOutputs QAttentionModule::forward(const torch::Tensor& grid, const torch::Tensor& proprio) {
-  const Trunk t = trunk(grid, proprio);
+QOutputs QAttentionModule::forward(const torch::Tensor& grid, const torch::Tensor& proprio,
+                                   const torch::Tensor& voxel) {
+  const Trunk t = trunk(grid, proprio, voxel);
   QOutputs out{t.translation, {}, {}};
   if (config_.is_last) heads(t.levels, out);
   return out;
 }
 
-Trunk QAttentionModule::trunk(const torch::Tensor& grid, const torch::Tensor& proprio) {
-  if (grid.size(0) != 1) return trunk_batch(grid, proprio);
-  Trunk twice = trunk_batch(torch::cat({grid, grid}), torch::cat({proprio, proprio}));
-  twice.translation = twice.translation.slice(0, 0, 1);
-  for (auto& level : twice.levels) level = level.slice(0, 0, 1);
-  return twice;
+Trunk QAttentionModule::trunk(const torch::Tensor& grid, const torch::Tensor& proprio, const torch::Tensor& voxel) {
+  Trunk t;
+  if (grid.size(0) != 1) {
+    t = trunk_batch(grid, proprio);
+  } else {
+    t = trunk_batch(torch::cat({grid, grid}), torch::cat({proprio, proprio}));
+    t.translation = t.translation.slice(0, 0, 1);
+    for (auto& level : t.levels) level = level.slice(0, 0, 1);
+  }
+  if (config_.is_last && config_.head_input == HeadInput::voxel) {
+    // The greedy voxel is the one acting takes at the last depth, in each grid of a tree too.
+    const auto at = voxel.defined() ? voxel.to(torch::kLong)
+                                    : t.translation.detach().reshape({t.translation.size(0), -1}).argmax(1);
+    t.levels.push_back(features_at(t.levels.back(), at));
+  }
+  return t;
 }
 
 void QAttentionModule::heads(const std::vector<torch::Tensor>& levels, QOutputs& out) {

@@ -24,7 +24,9 @@ struct QOutputs {
 // activations the dense head pools (kept so that the head can run later on some samples only).
 struct Trunk {
   torch::Tensor translation;           // [B, V, V, V]
-  std::vector<torch::Tensor> levels;   // [B, C_l, ...] per pooled level; empty unless is_last
+  // [B, C_l, ...] per pooled level, then with HeadInput::voxel the finest level's features at
+  // the chosen voxel, [B, C_0]; empty unless is_last.
+  std::vector<torch::Tensor> levels;
 };
 
 // One depth's network. Parameter names are those of the architecture's module tree; for
@@ -37,13 +39,15 @@ class QAttentionModule : public torch::nn::Module {
   const NetConfig& config() const { return config_; }
 
   // grid: [B, channels, V, V, V] (channels first: see channels_first), proprio: [B, proprio].
-  // trunk + heads.
-  QOutputs forward(const torch::Tensor& grid, const torch::Tensor& proprio);
+  // trunk + heads. `voxel` ([B] flat indices into the Q volume, undefined: each sample's
+  // greedy voxel) is the voxel whose features a HeadInput::voxel head reads; the learner passes
+  // the transitions' own, so that the rotation Q values it trains are those of the voxel taken.
+  QOutputs forward(const torch::Tensor& grid, const torch::Tensor& proprio, const torch::Tensor& voxel = {});
   // A batch of one runs as two copies of the sample: LibTorch 1.13 sends batch-1 3D
   // convolutions with 3x3x3 kernels to its vol2col fallback rather than oneDNN, which makes
   // them slower than the same convolutions at batch 2 (measured with PyTorch 1.13 on 2 threads:
   // light 41 ms at batch 1 against 6 ms at batch 2, arm 368 ms against 77 ms).
-  Trunk trunk(const torch::Tensor& grid, const torch::Tensor& proprio);
+  Trunk trunk(const torch::Tensor& grid, const torch::Tensor& proprio, const torch::Tensor& voxel = {});
   // Rotation and gripper Q values (into `out`) from a trunk's levels, or from rows of them:
   // pooled features, then the dense head. Row by row the same values as in the whole batch.
   void heads(const std::vector<torch::Tensor>& levels, QOutputs& out);

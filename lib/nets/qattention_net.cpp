@@ -20,6 +20,14 @@ Architecture architecture_from_name(const std::string& name) {
   throw Error("unknown network architecture '" + name + "' (expected arm or light)");
 }
 
+const char* head_input_name(HeadInput input) { return input == HeadInput::voxel ? "voxel" : "pooled"; }
+
+HeadInput head_input_from_name(const std::string& name) {
+  if (name == "pooled") return HeadInput::pooled;
+  if (name == "voxel") return HeadInput::voxel;
+  throw Error("unknown head input '" + name + "' (expected pooled or voxel)");
+}
+
 int default_base_channels(Architecture architecture) { return architecture == Architecture::arm ? 64 : 16; }
 
 void NetConfig::validate() const {
@@ -35,6 +43,8 @@ void NetConfig::validate() const {
     refuse("base_channels of the " + std::string(architecture_name(architecture)) +
            " network must be a positive multiple of " + std::to_string(multiple) + ", got " +
            std::to_string(base_channels));
+  if (head_input == HeadInput::voxel && architecture != Architecture::light)
+    refuse("head input 'voxel' is built for the light architecture only");
 }
 
 QAttentionNet::QAttentionNet(const NetConfig& config) : config_(config), module_(make_qattention_module(config)) {}

@@ -26,6 +26,15 @@ const char* architecture_name(Architecture architecture);      // "arm", "light"
 Architecture architecture_from_name(const std::string& name);  // throws Error
 int default_base_channels(Architecture architecture);          // arm 64, light 16
 
+// What the last depth's dense head (rotation and gripper Q values) reads.
+enum class HeadInput {
+  pooled,  // as published: every U-Net level pooled over the whole grid (maximum, soft-argmax position)
+  voxel,   // our variation: those, and the finest level's features at the chosen voxel (light only)
+};
+
+const char* head_input_name(HeadInput input);        // "pooled", "voxel"
+HeadInput head_input_from_name(const std::string& name);  // throws Error
+
 // Rotation Q values: 3 Euler axes x 72 bins of 5 degrees; gripper: open / close.
 constexpr int kRotationAxes = 3;
 using robot::kRotationBins;  // the action encoding's bins (robot/rotation_bins.hpp)
@@ -41,6 +50,7 @@ struct NetConfig {
   int proprio = 4;
   Architecture architecture = Architecture::light;
   int base_channels = 16;  // kernels of the first U-Net level (default_base_channels())
+  HeadInput head_input = HeadInput::pooled;
 
   // Throws Error naming the first setting a network cannot be built with.
   void validate() const;

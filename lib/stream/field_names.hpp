@@ -57,6 +57,7 @@ namespace qte::stream::fields {
   X(demo, "demo")                           \
   X(architecture, "architecture")           \
   X(base_channels, "base_channels")         \
+  X(head_input, "head_input")               \
   X(channels, "channels")                   \
   X(proprio, "proprio")                     \
   X(depths, "depths")                       \

@@ -226,6 +226,8 @@ constexpr FieldSchema checkpoint_fields[] = {
      "`arm` (the published inception 3D U-Net) or `light` (the CPU default)"},
     {fields::base_channels, "int64", "[]", false,
      "the networks' configuration"},
+    {fields::head_input, "str", "[n]", true,
+     "optional (default `pooled`): what the last depth's dense head reads: `pooled` (as published) or `voxel` (also the finest level's features at the chosen voxel)"},
     {fields::voxels, "int64", "[]", false,
      "the networks' configuration"},
     {fields::channels, "int64", "[]", false,

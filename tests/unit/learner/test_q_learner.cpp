@@ -397,7 +397,10 @@ TEST(QLearner, GradientsAreClippedByValuePerDepth) {
 // loss of the taken action (at the last depth a mean over translation, three rotation axes and
 // the gripper), lambda * mean|Q|, and on a demonstration's sample the large margins
 // max_a [Q(a) + m [a != taken]] - Q(taken) by a loop over every action, meant like the TD loss.
-std::vector<double> loss_by_hand(learner::QLearner& learner, const learner::Minibatch& batch, double q_reg, double m) {
+// With heads_at_taken_voxel, the last depth's rotation and gripper Q values are those of the
+// head reading each transition's own voxel (HeadInput::voxel), not the greedy one.
+std::vector<double> loss_by_hand(learner::QLearner& learner, const learner::Minibatch& batch, double q_reg, double m,
+                                 bool heads_at_taken_voxel = false) {
   const learner::Targets targets = learner.targets(batch);
   const int n = batch.size, cells = V * V * V;
   const auto margin = [&](const float* q, int count, int64_t taken) {
@@ -407,7 +410,19 @@ std::vector<double> loss_by_hand(learner::QLearner& learner, const learner::Mini
   };
   std::vector<double> losses;
   for (int d = 0; d < 2; ++d) {
-    const nets::QValues q = learner.online()[d].predict(batch.grids[d].data(), batch.proprio.data(), n);
+    nets::QValues q = learner.online()[d].predict(batch.grids[d].data(), batch.proprio.data(), n);
+    if (d == 1 && heads_at_taken_voxel) {
+      torch::NoGradGuard no_grad;
+      const int channels = learner.online()[d].config().channels;
+      const auto grid = torch::from_blob(const_cast<float*>(batch.grids[d].data()), {n, V, V, V, channels});
+      const auto proprio = torch::from_blob(const_cast<float*>(batch.proprio.data()), {n, 4});
+      std::vector<int64_t> voxels(batch.voxel[d].begin(), batch.voxel[d].end());
+      const nets::QOutputs out = learner.online()[d].module().forward(nets::channels_first(grid), proprio,
+                                                                       torch::tensor(voxels, torch::kLong));
+      const auto rotation = out.rotation.contiguous(), gripper = out.gripper.contiguous();
+      q.rotation.assign(rotation.data_ptr<float>(), rotation.data_ptr<float>() + rotation.numel());
+      q.gripper.assign(gripper.data_ptr<float>(), gripper.data_ptr<float>() + gripper.numel());
+    }
     double loss = 0;
     for (int i = 0; i < n; ++i) {
       const float* t = q.translation.data() + static_cast<std::size_t>(i) * cells;
@@ -470,4 +485,22 @@ TEST(QLearner, DemoMarginAddsTheLargeMarginsOfTheDemonstrationsOnly) {
   // Not a setting older checkpoints lack: the JSON names it only when it is used.
   EXPECT_NE(config.json().find("\"demo_margin\": 0.4"), std::string::npos);
   EXPECT_EQ(small_config().json().find("demo_margin"), std::string::npos);
+}
+
+// --head-input voxel: the head the learner trains reads each transition's own voxel, so its
+// rotation Q values are those of the place the transition went to; the greedy voxel's differ.
+TEST(QLearner, VoxelHeadIsTrainedAtTheTransitionsVoxel) {
+  learner::LearnerConfig config = small_config();
+  config.net.head_input = nets::HeadInput::voxel;
+  Seeded s(config, 19);
+  const std::vector<double> taken = loss_by_hand(s.trainer, s.batch, 1.0, 0, true);
+  const std::vector<double> greedy = loss_by_hand(s.trainer, s.batch, 1.0, 0, false);
+  const learner::StepStats stats = s.trainer.gradients(s.batch);
+  EXPECT_NEAR(stats.depth_loss[0], taken[0], 1e-5 * std::abs(taken[0]) + 1e-7);
+  EXPECT_NEAR(stats.depth_loss[1], taken[1], 1e-5 * std::abs(taken[1]) + 1e-7);
+  EXPECT_GT(std::abs(taken[1] - greedy[1]), 1e-4) << "the batch's voxels are the greedy ones: the case shows nothing";
+  EXPECT_NE(config.json().find("\"head_input\": \"voxel\""), std::string::npos);
+  EXPECT_EQ(small_config().json().find("head_input"), std::string::npos);
+  config.net.architecture = nets::Architecture::arm;
+  EXPECT_THROW(config.validate(), UsageError);
 }

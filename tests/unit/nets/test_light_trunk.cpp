@@ -135,7 +135,14 @@ TEST(LightTrunk, Bf16EqualsFp32WithinBf16Rounding) {
     use_precision(Precision::fp32);
     const Pass fp32 = training_pass(*net, grid, proprio, true);
     use_precision(Precision::bf16);
-    ASSERT_EQ(precision_running(3, config.channels, config.base_channels, config.voxels), Precision::bf16);
+    // A processor can have the instructions and oneDNN still choose, for some of these layers,
+    // kernels the trunk does not run (not its vectorised ones, or other layouts): the trunk then
+    // runs fp32, as precision_in_use tells the user, and there is no bf16 to compare here.
+    if (precision_running(3, config.channels, config.base_channels, config.voxels) != Precision::bf16) {
+      use_precision(Precision::fp32);
+      GTEST_SKIP() << "bf16 instructions, but oneDNN's kernels for these layers are not ones the trunk runs in bf16 "
+                      "here (ONEDNN_VERBOSE=1 names them): the trunk runs fp32";
+    }
     const Pass bf16 = training_pass(*net, grid, proprio, true), again = training_pass(*net, grid, proprio, true);
     use_precision(Precision::fp32);
     const std::string depth = is_last ? "last depth: " : "depth 0: ";

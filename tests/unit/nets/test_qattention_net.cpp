@@ -12,6 +12,7 @@
 #include "common/error.hpp"
 #include "nets/checkpoint.hpp"
 #include "nets/qattention_modules.hpp"
+#include "stream/field_names.hpp"
 #include "stream/writer.hpp"
 
 namespace qte::nets {
@@ -232,6 +233,54 @@ TEST(QAttentionNet, RefusesConfigsItCannotBuild) {
   config = config_of(Architecture::arm, 30);
   EXPECT_THROW(QAttentionNet{config}, Error);
   EXPECT_THROW(architecture_from_name("resnet"), Error);
+  config = config_of(Architecture::arm, 8);
+  config.head_input = HeadInput::voxel;  // built for light only
+  EXPECT_THROW(QAttentionNet{config}, Error);
+  EXPECT_THROW(head_input_from_name("local"), Error);
+}
+
+// HeadInput::voxel: the head also reads the finest level's features at one voxel, each sample's
+// greedy voxel unless the caller names one. Checked against those features read off the trunk's
+// finest level by hand, at the argmax found by hand.
+TEST(QAttentionNet, VoxelHeadReadsTheFeaturesAtTheVoxelTaken) {
+  NetConfig config = config_of(Architecture::light, 8);
+  config.is_last = true;
+  config.head_input = HeadInput::voxel;
+  seed_torch(21);
+  const auto module = make_qattention_module(config);
+  EXPECT_EQ(module->named_parameters()["head.0.weight"].size(1), 4 * (8 + 16 + 32 + 8) + 8);
+  const int batch = 3;
+  const auto grid = torch::rand({batch, C, V, V, V}), proprio = torch::rand({batch, 4});
+  const Trunk trunk = module->trunk(grid, proprio);
+  ASSERT_EQ(trunk.levels.size(), 5u);
+  const auto finest = trunk.levels[3].contiguous(), at_voxel = trunk.levels[4].contiguous();
+  const auto q = trunk.translation.contiguous();
+  std::vector<int64_t> greedy;
+  for (int b = 0; b < batch; ++b) {
+    const float* volume = q.data_ptr<float>() + b * V * V * V;
+    const int64_t i = std::max_element(volume, volume + V * V * V) - volume;
+    greedy.push_back(i);
+    const int64_t x = i / (V * V), y = i / V % V, z = i % V;
+    for (int c = 0; c < 8; ++c)
+      ASSERT_EQ(at_voxel[b][c].item<float>(), finest[b][c][x][y][z].item<float>()) << "sample " << b;
+  }
+  const auto greedy_voxels = torch::tensor(greedy, torch::kLong);
+  const QOutputs by_default = module->forward(grid, proprio), named = module->forward(grid, proprio, greedy_voxels);
+  EXPECT_TRUE(torch::equal(by_default.rotation, named.rotation));
+  EXPECT_TRUE(torch::equal(by_default.gripper, named.gripper));
+  // Another voxel, other features: other rotation Q values, the same translation Q values.
+  const QOutputs elsewhere = module->forward(grid, proprio, (greedy_voxels + 1) % (V * V * V));
+  EXPECT_TRUE(torch::equal(elsewhere.translation, by_default.translation));
+  EXPECT_FALSE(torch::equal(elsewhere.rotation, by_default.rotation));
+  // A leaf's heads later (tree expansion) are its heads at once.
+  QAttentionNet net(config);
+  const auto grids = torch::rand({batch, V, V, V, C});
+  const QValues all = net.predict(grids.data_ptr<float>(), proprio.data_ptr<float>(), batch);
+  QValues leaves = net.predict_leaves(grids.data_ptr<float>(), proprio.data_ptr<float>(), batch);
+  ASSERT_TRUE(leaves.heads_for);
+  leaves.heads_for({0, 1, 2}, leaves);
+  EXPECT_EQ(leaves.rotation, all.rotation);
+  EXPECT_EQ(leaves.gripper, all.gripper);
 }
 
 // A real learning check: two scenes with a block at different places; the target voxel is the
@@ -288,6 +337,28 @@ TEST(Checkpoint, RoundTripGivesIdenticalOutputs) {
     EXPECT_EQ(a.rotation, b.rotation);
     EXPECT_EQ(a.gripper, b.gripper);
   }
+  std::remove(path.c_str());
+}
+
+// The head's input travels with the checkpoint; the published one writes no field for it.
+TEST(Checkpoint, HeadInputRoundTrips) {
+  const std::string path = temp_path("head_input.rec");
+  NetConfig config = config_of(Architecture::light, 8);
+  seed_torch(13);
+  save_checkpoint(path, make_coarse_to_fine_nets(config, 2), nullptr, 0);
+  EXPECT_EQ(read_checkpoint_config(path).net.head_input, HeadInput::pooled);
+  EXPECT_FALSE(read_online_checkpoint(path).has(qte::fields::head_input));
+  config.head_input = HeadInput::voxel;
+  auto saved = make_coarse_to_fine_nets(config, 2);
+  save_checkpoint(path, saved, nullptr, 0);
+  EXPECT_EQ(read_checkpoint_config(path).net.head_input, HeadInput::voxel);
+  auto loaded = make_coarse_to_fine_nets(config, 2);
+  load_checkpoint(path, loaded);
+  const auto grids = torch::rand({2, V, V, V, C}), proprio = torch::rand({2, 4});
+  EXPECT_EQ(saved[1].predict(grids.data_ptr<float>(), proprio.data_ptr<float>(), 2).rotation,
+            loaded[1].predict(grids.data_ptr<float>(), proprio.data_ptr<float>(), 2).rotation);
+  auto pooled = make_coarse_to_fine_nets(config_of(Architecture::light, 8), 2);
+  EXPECT_THROW(load_checkpoint(path, pooled), Error);  // the head's first layer is wider
   std::remove(path.c_str());
 }
 
