@@ -132,9 +132,11 @@ CheckpointConfig checkpoint_config(const stream::Record& record) {
   config.net.base_channels = integer(fields::base_channels, 1, 512);
   if (record.has(fields::head_input)) {
     const std::string input = record.string(fields::head_input);
-    if (input != "pooled" && input != "voxel")
+    try {
+      config.net.head_input = head_input_from_name(input);
+    } catch (const Error&) {  // damage, named by the field: a StreamError
       record.fail(fields::head_input, "pooled or voxel, got '" + input + "'");
-    config.net.head_input = head_input_from_name(input);
+    }
   }
   config.net.voxels = integer(fields::voxels, 4, 128);
   config.net.channels = integer(fields::channels, 1, 64);

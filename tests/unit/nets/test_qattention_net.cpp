@@ -359,6 +359,9 @@ TEST(Checkpoint, HeadInputRoundTrips) {
             loaded[1].predict(grids.data_ptr<float>(), proprio.data_ptr<float>(), 2).rotation);
   auto pooled = make_coarse_to_fine_nets(config_of(Architecture::light, 8), 2);
   EXPECT_THROW(load_checkpoint(path, pooled), Error);  // the head's first layer is wider
+  stream::Record damaged = read_online_checkpoint(path);
+  damaged.set_string(qte::fields::head_input, "local");
+  EXPECT_THROW(checkpoint_config(damaged), StreamError);  // named by the field, as damage
   std::remove(path.c_str());
 }
 
