@@ -124,6 +124,13 @@ StepStats QLearner::gradients(const Minibatch& batch) {
                              large_margin(out.rotation.reshape({n * 3, -1}), bins.view({n * 3, 1}), m).view({n, 3}),
                              large_margin(out.gripper, open, m).unsqueeze(1)}, 1).mean(1);
       regulariser = regulariser + torch::cat({out.rotation.reshape({n, -1}), out.gripper}, 1).abs().mean(1);
+      {
+        torch::NoGradGuard no_grad;
+        const auto rotation_agrees = out.rotation.argmax(2).eq(bins.squeeze(2)).to(torch::kDouble).mean(0);
+        for (int axis = 0; axis < 3; ++axis) stats.head_agreement.push_back(rotation_agrees[axis].item<double>());
+        stats.head_agreement.push_back(out.gripper.argmax(1).eq(open.squeeze(1)).to(torch::kDouble).mean().item<double>());
+        stats.rotation_loss = huber(rotation, floats(targets.rotation, {n, 3})).mean().item<double>();
+      }
     }
     if (m > 0) per_sample = per_sample + margin * floats(batch.demo, {n});
     const auto loss = ((per_sample + config_.q_regularisation * regulariser) * weights).mean();

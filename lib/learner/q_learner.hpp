@@ -25,6 +25,11 @@ struct StepStats {
   std::vector<double> depth_loss, q_mean, q_max;  // per depth (translation Q of the batch)
   std::vector<double> td_errors;                  // per sample: mean over depths of |TD error|
   std::vector<double> mean_branches;              // the tree target's, per non-leaf depth (Targets)
+  // The last depth's head against the batch's own actions: per rotation axis and for the
+  // gripper, the share of samples whose greedy bin is the transition's (on demonstrations: how
+  // well the head fits them), and the mean Huber loss of the three rotation terms.
+  std::vector<double> head_agreement;  // x, y, z, gripper
+  double rotation_loss = 0;
   // Where the step's wall time went (the benchmarks' table): the bootstrap targets, the forwards
   // with gradients and the loss, the backward and clipping, Adam and the soft target update.
   double targets_s = 0, forward_s = 0, backward_s = 0, optimiser_s = 0;

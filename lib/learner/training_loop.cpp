@@ -39,6 +39,8 @@ std::string csv_header(int depths, bool adaptive_tree) {
   h += ",td_mean,priority_mean,steps_per_s,elapsed_s";
   if (adaptive_tree)
     for (int d = 1; d < depths; ++d) h += ",branches_d" + std::to_string(d);
+  // The head against the batches' own actions (StepStats), means over the rows' steps.
+  h += ",agree_rotation_x,agree_rotation_y,agree_rotation_z,agree_gripper,loss_rotation";
   return h;
 }
 
@@ -251,6 +253,9 @@ void TrainingLoop::train() {
     replay_.update_priorities(sample.indices, stats.td_errors);
     for (double td : stats.td_errors) td_sum_ += td;
     td_count_ += static_cast<int64_t>(stats.td_errors.size());
+    for (std::size_t i = 0; i < stats.head_agreement.size() && i < head_agreement_sum_.size(); ++i)
+      head_agreement_sum_[i] += stats.head_agreement[i];
+    rotation_loss_sum_ += stats.rotation_loss;
     ++window_steps_;
     if (learner_.step() % options_.log_every == 0 || learner_.step() == options_.steps) log_row(stats);
     if (learner_.step() % options_.checkpoint_every == 0) save();
@@ -271,6 +276,9 @@ void TrainingLoop::log_row(const StepStats& stats) {
       << ',' << rate << ',' << elapsed;
   if (learner_.config().tree_branching.adaptive())
     for (double b : stats.mean_branches) row << ',' << b;
+  const double window = static_cast<double>(std::max<int64_t>(1, window_steps_));
+  for (double a : head_agreement_sum_) row << ',' << a / window;
+  row << ',' << rotation_loss_sum_ / window;
   if (metrics_.is_open()) metrics_ << row.str() << '\n' << std::flush;
   progress_ << "qattn-train: step " << learner_.step() << "/" << options_.steps << "  loss " << std::setprecision(4)
             << stats.loss << "  q_max";
@@ -281,6 +289,8 @@ void TrainingLoop::log_row(const StepStats& stats) {
   window_steps_ = 0;
   td_sum_ = priority_sum_ = 0;
   td_count_ = 0;
+  head_agreement_sum_.assign(head_agreement_sum_.size(), 0.0);
+  rotation_loss_sum_ = 0;
 }
 
 }  // namespace qte::learner

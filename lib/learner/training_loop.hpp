@@ -90,6 +90,8 @@ class TrainingLoop {
   std::chrono::steady_clock::time_point started_, window_start_;
   int64_t window_steps_ = 0, td_count_ = 0;
   double td_sum_ = 0, priority_sum_ = 0;
+  std::vector<double> head_agreement_sum_ = std::vector<double>(4, 0.0);  // StepStats::head_agreement (x, y, z, gripper) summed over the window
+  double rotation_loss_sum_ = 0;
 };
 
 }  // namespace qte::learner

@@ -2,6 +2,7 @@
 // checkpoint that resumes a run step for step.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <random>
 
@@ -503,4 +504,39 @@ TEST(QLearner, VoxelHeadIsTrainedAtTheTransitionsVoxel) {
   EXPECT_EQ(small_config().json().find("head_input"), std::string::npos);
   config.net.architecture = nets::Architecture::arm;
   EXPECT_THROW(config.validate(), UsageError);
+}
+
+// The metrics' agreement columns: per rotation axis and for the gripper, the share of the
+// batch whose greedy bin is the transition's own, counted here from the networks' outputs on a
+// batch whose actions are made to agree with the greedy bins in a known pattern; and the mean
+// Huber loss of the rotation terms, from the same outputs and targets.
+TEST(QLearner, HeadAgreementIsTheShareOfTheBatchWhoseGreedyBinIsTheTransitions) {
+  Seeded s(small_config(), 23);
+  const int n = s.batch.size;
+  const nets::QValues q = s.trainer.online()[1].predict(s.batch.grids[1].data(), s.batch.proprio.data(), n);
+  const auto greedy = [](const float* v, int count) { return static_cast<int>(std::max_element(v, v + count) - v); };
+  std::vector<double> agree(4, 0.0);
+  for (int i = 0; i < n; ++i) {
+    for (int axis = 0; axis < 3; ++axis) {
+      const int best = greedy(q.rotation.data() + (static_cast<std::size_t>(i) * 3 + axis) * 72, 72);
+      const bool same = (i + axis) % 3 != 0;
+      s.batch.rotation_bins[3 * i + axis] = same ? best : (best + 5) % 72;
+      agree[axis] += same ? 1.0 / n : 0.0;
+    }
+    const int best = greedy(q.gripper.data() + static_cast<std::size_t>(i) * 2, 2);
+    s.batch.gripper[i] = i == 0 ? best : 1 - best;
+    agree[3] += i == 0 ? 1.0 / n : 0.0;
+  }
+  const learner::Targets targets = s.trainer.targets(s.batch);
+  double rotation_loss = 0;
+  for (int i = 0; i < n; ++i)
+    for (int axis = 0; axis < 3; ++axis) {
+      const float* r = q.rotation.data() + (static_cast<std::size_t>(i) * 3 + axis) * 72;
+      rotation_loss += huber(r[s.batch.rotation_bins[3 * i + axis]] - targets.rotation[3 * i + axis]) / (3 * n);
+    }
+  const learner::StepStats stats = s.trainer.gradients(s.batch);
+  ASSERT_EQ(stats.head_agreement.size(), 4u);
+  for (int k = 0; k < 4; ++k) EXPECT_DOUBLE_EQ(stats.head_agreement[k], agree[k]) << "column " << k;
+  EXPECT_NE(agree[0], agree[1]) << "every axis agrees alike: the case shows nothing";
+  EXPECT_NEAR(stats.rotation_loss, rotation_loss, 1e-5 * rotation_loss + 1e-7);
 }

@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -111,8 +112,26 @@ TEST(TrainingLoop, FollowTakesTheStepsTheReplayRatioAllowsAndStops) {
   std::string header, line;
   std::getline(rows, header);
   EXPECT_EQ(header.rfind("step,transitions,agent_transitions,replay,demos,loss", 0), 0u) << header;
+  const auto fields = [](const std::string& text) {
+    std::vector<std::string> out;
+    std::istringstream in(text);
+    for (std::string f; std::getline(in, f, ',');) out.push_back(f);
+    return out;
+  };
+  const std::vector<std::string> names = fields(header);
+  const auto column = [&](const std::string& name) { return std::find(names.begin(), names.end(), name) - names.begin(); };
   int count = 0;
-  while (std::getline(rows, line)) ++count;
+  while (std::getline(rows, line)) {
+    ++count;
+    const std::vector<std::string> row = fields(line);
+    ASSERT_EQ(row.size(), names.size()) << line;
+    for (const char* name : {"agree_rotation_x", "agree_rotation_y", "agree_rotation_z", "agree_gripper"}) {
+      ASSERT_LT(column(name), static_cast<long>(names.size())) << name << " missing from " << header;
+      const double share = std::stod(row[column(name)]);
+      EXPECT_TRUE(share >= 0 && share <= 1) << name << " " << share;
+    }
+    EXPECT_GE(std::stod(row[column("loss_rotation")]), 0.0);
+  }
   EXPECT_EQ(count, 4);
   // The checkpoint of the last step holds the loop's state.
   stream::RecordReader reader(dir + "/six/ckpt/latest.rec");
