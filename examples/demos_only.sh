@@ -8,14 +8,15 @@
 # Usage: demos_only.sh TASK OUT_DIR   (the built programs on PATH; settings from the
 #        environment: SEED 0, DEMOS 10, IMAGE 256x256, STEPS 2000, N_STEP 3, VARIATION 0, CHAIN_STEPS reset
 #        (keyframe --chain-steps), KS "1 10" (the K the networks act with), DEMO_MARGIN 0
-#        (qattn-train --demo-margin), HEAD_INPUT pooled (qattn-train --head-input),
+#        (qattn-train --demo-margin), DEMO_CROSS_ENTROPY 0 (qattn-train --demo-cross-entropy),
+#        HEAD_INPUT pooled (qattn-train --head-input),
 #        NET_OPTIONS e.g. "--depths 3 --offset 0.15,0.05", PLAN_OPTIONS as learn.sh's; make -C
 #        examples demos-only, which sets PLAN_OPTIONS as the task's runs have it).
 # Writes OUT_DIR/failures-stepSTEPS-kK.csv; resumable (the learner resumes, finished CSVs stay).
 set -euo pipefail
 task=$1 out=$2
 : "${SEED:=0}" "${DEMOS:=10}" "${IMAGE:=256x256}" "${STEPS:=2000}" "${N_STEP:=3}" "${VARIATION:=0}" "${NET_OPTIONS:=}"
-: "${CHAIN_STEPS:=reset}" "${KS:=1 10}" "${DEMO_MARGIN:=0}" "${HEAD_INPUT:=pooled}"
+: "${CHAIN_STEPS:=reset}" "${KS:=1 10}" "${DEMO_MARGIN:=0}" "${DEMO_CROSS_ENTROPY:=0}" "${HEAD_INPUT:=pooled}"
 here=$(cd "$(dirname "$0")" && pwd)
 source "$here/common.sh"
 mkdir -p "$out"
@@ -26,7 +27,7 @@ if [ ! -f "$out/replay.rec" ]; then  # learn.sh's demonstrations for SEED, the s
   mv "$out/replay.rec.tmp" "$out/replay.rec"
 fi
 qattn-train --resume --steps "$STEPS" --start-after 0 --checkpoint-every 250 --keep 20 --architecture light --batch 32 \
-  --n-step "$N_STEP" --demo-margin "$DEMO_MARGIN" --head-input "$HEAD_INPUT" $NET_OPTIONS --seed "$SEED" --threads 1 --checkpoint-dir "$out/ckpt" --metrics "$out/train.csv" \
+  --n-step "$N_STEP" --demo-margin "$DEMO_MARGIN" --demo-cross-entropy "$DEMO_CROSS_ENTROPY" --head-input "$HEAD_INPUT" $NET_OPTIONS --seed "$SEED" --threads 1 --checkpoint-dir "$out/ckpt" --metrics "$out/train.csv" \
   "$out/replay.rec" 2>> "$out/train.log"
 for k in $KS; do
   csv=$out/failures-step$STEPS-k$k.csv

@@ -52,6 +52,10 @@ std::vector<cli::OptionSpec> learner_config_options() {
                        "DQfD's large-margin loss on the demonstrations: each head's demonstrated action's Q "
                        "pushed M above every other's (0: none, as published)",
                        default_text(d.demo_margin), 0, 1e3),
+      cli::real_option("demo-cross-entropy", "W",
+                       "our variation: W times the cross-entropy of the rotation and gripper head's Q values "
+                       "against the demonstrated bins, on the demonstrations (0: none, as published)",
+                       default_text(d.demo_cross_entropy), 0, 1e3),
   };
 }
 
@@ -76,6 +80,7 @@ LearnerConfig learner_config_from(const cli::Arguments& args) {
   config.tree_target_k = config.tree_branching.k;
   config.n_step = static_cast<int>(args.integer("n-step"));
   config.demo_margin = args.real("demo-margin");
+  config.demo_cross_entropy = args.real("demo-cross-entropy");
   config.validate();
   config.check_memory(static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE)));
   return config;

@@ -124,6 +124,11 @@ StepStats QLearner::gradients(const Minibatch& batch) {
                              large_margin(out.rotation.reshape({n * 3, -1}), bins.view({n * 3, 1}), m).view({n, 3}),
                              large_margin(out.gripper, open, m).unsqueeze(1)}, 1).mean(1);
       regulariser = regulariser + torch::cat({out.rotation.reshape({n, -1}), out.gripper}, 1).abs().mean(1);
+      if (config_.demo_cross_entropy > 0) {  // -log softmax at the demonstrated bins, the four heads' mean
+        const auto log_p = torch::cat({out.rotation.log_softmax(2).gather(2, bins).squeeze(2),
+                                       out.gripper.log_softmax(1).gather(1, open)}, 1);
+        per_sample = per_sample - config_.demo_cross_entropy * log_p.mean(1) * floats(batch.demo, {n});
+      }
       {
         torch::NoGradGuard no_grad;
         const auto rotation_agrees = out.rotation.argmax(2).eq(bins.squeeze(2)).to(torch::kDouble).mean(0);

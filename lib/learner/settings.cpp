@@ -25,6 +25,7 @@ std::string LearnerConfig::json() const {
     << ", \"q_regularisation\": " << q_regularisation << ", \"huber_delta\": " << huber_delta
     << ", \"tree_target_k\": " << tree_target_k << ", \"n_step\": " << n_step;
   if (demo_margin > 0) s << ", \"demo_margin\": " << demo_margin;  // only then: older checkpoints still resume
+  if (demo_cross_entropy > 0) s << ", \"demo_cross_entropy\": " << demo_cross_entropy;  // likewise
   if (net.head_input != nets::HeadInput::pooled)  // only then, likewise
     s << ", \"head_input\": \"" << nets::head_input_name(net.head_input) << "\"";
   if (tree_branching.adaptive())  // only then: checkpoints from before adaptive K still resume
@@ -50,6 +51,7 @@ void LearnerConfig::validate() const {
       {"huber-delta", huber_delta},
       {"n-step", static_cast<double>(n_step)},
       {"demo-margin", demo_margin},
+      {"demo-cross-entropy", demo_cross_entropy},
   };
   for (const auto& [name, value] : values) cli::check_range(options, name, value, "the learner's settings");
   if (net.head_input == nets::HeadInput::voxel && net.architecture != nets::Architecture::light)

@@ -35,6 +35,12 @@ struct LearnerConfig {
   // trains only the taken action's Q, so an output never demonstrated in a scene is never
   // told it is worse there: docs/learner.md).
   double demo_margin = 0;
+  // Our variation: weight W of a cross-entropy term on the demonstrations' transitions, the
+  // softmax of each of the last depth's head outputs (three rotation axes, the gripper) against
+  // the demonstrated bin, the four's mean, added to their TD loss. It tells the head directly
+  // which bin the demonstration took where the TD loss only raises that bin's Q. 0: none, as
+  // published.
+  double demo_cross_entropy = 0;
 
   // The settings a resumed run must share with its checkpoint, as JSON.
   std::string json() const;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <random>
 
@@ -539,4 +540,41 @@ TEST(QLearner, HeadAgreementIsTheShareOfTheBatchWhoseGreedyBinIsTheTransitions) 
   for (int k = 0; k < 4; ++k) EXPECT_DOUBLE_EQ(stats.head_agreement[k], agree[k]) << "column " << k;
   EXPECT_NE(agree[0], agree[1]) << "every axis agrees alike: the case shows nothing";
   EXPECT_NEAR(stats.rotation_loss, rotation_loss, 1e-5 * rotation_loss + 1e-7);
+}
+
+// --demo-cross-entropy: on the demonstrations' samples only, W times the mean over the head's
+// four outputs (three rotation axes, the gripper) of -log softmax at the demonstrated bin,
+// worked out here from the networks' outputs by a loop over the bins; the translation depths
+// are untouched.
+TEST(QLearner, DemoCrossEntropyAddsTheHeadsLogLossOnTheDemonstrationsOnly) {
+  learner::LearnerConfig config = small_config();
+  config.demo_cross_entropy = 0.25;
+  Seeded s(config, 19);
+  ASSERT_EQ(s.batch.size, 4);
+  const int n = s.batch.size;
+  s.batch.demo = {1, 0, 1, 0};
+  s.batch.weights = {1.0, 0.5, 0.25, 0.75};
+  const std::vector<double> plain = loss_by_hand(s.trainer, s.batch, 1.0, 0);
+  const nets::QValues q = s.trainer.online()[1].predict(s.batch.grids[1].data(), s.batch.proprio.data(), n);
+  const auto minus_log_softmax = [](const float* v, int count, int taken) {
+    double sum = 0;
+    for (int b = 0; b < count; ++b) sum += std::exp(static_cast<double>(v[b]));
+    return std::log(sum) - v[taken];
+  };
+  double extra = 0;
+  for (int i = 0; i < n; ++i) {
+    if (s.batch.demo[i] == 0) continue;
+    double ce = 0;
+    for (int axis = 0; axis < 3; ++axis)
+      ce += minus_log_softmax(q.rotation.data() + (static_cast<std::size_t>(i) * 3 + axis) * 72, 72,
+                              static_cast<int>(s.batch.rotation_bins[3 * i + axis]));
+    ce += minus_log_softmax(q.gripper.data() + static_cast<std::size_t>(i) * 2, 2, static_cast<int>(s.batch.gripper[i]));
+    extra += s.batch.weights[i] * 0.25 * (ce / 4) / n;
+  }
+  const learner::StepStats stats = s.trainer.gradients(s.batch);
+  EXPECT_NEAR(stats.depth_loss[0], plain[0], 1e-5 * std::abs(plain[0]) + 1e-7);
+  EXPECT_NEAR(stats.depth_loss[1], plain[1] + extra, 1e-5 * (plain[1] + extra));
+  EXPECT_GT(extra, 0.1) << "72 bins near uniform cost about log 72: a smaller term shows nothing";
+  EXPECT_NE(config.json().find("\"demo_cross_entropy\": 0.25"), std::string::npos);
+  EXPECT_EQ(small_config().json().find("demo_cross_entropy"), std::string::npos);
 }
