@@ -58,8 +58,11 @@ static cli::Usage usage() {
       "killed one resumes to the same bytes. The run ends at --steps, or when --stop-file "
       "exists and the steps the transitions allow are done.",
       "Metrics go to --metrics as CSV (step, transitions, replay size, loss and per-depth "
-      "loss, mean and max Q per depth, mean TD error, steps per second); a progress line "
-      "goes to standard error. A non-finite loss stops the run with the step and the "
+      "loss, mean and max Q per depth, mean TD error, steps per second; last, how well the "
+      "rotation and gripper head agrees with the batches' own actions: agree_rotation_x, _y, "
+      "_z and agree_gripper, the share of samples whose greedy bin is the transition's, and "
+      "loss_rotation, the mean Huber loss of the rotation terms; on demonstrations alone these "
+      "say whether the head fits them); a progress line goes to standard error. A non-finite loss stops the run with the step and the "
       "records of the batch; the last checkpoint stays the last good one. Transitions of "
       "another voxel size, depth count or grid edge (keyframed with another --offset or "
       "scene) are refused with their position.",
