@@ -37,8 +37,10 @@ and has one reason (REASONS), the first cause in the episode that explains the f
                        way in swept into it; with the simulator's objects only)
     grasp_missed       the gripper closed and held nothing, on a task that needs a grasp (the
                        expert holds an object on the scene; always when sorting one stream)
-    dropped            the gripper opened on a target it held (let go of it, or put it where
-                       the task does not count it)
+    dropped            the gripper opened on a target it held, and the target did not come to
+                       rest where the expert let one go on the same scene (within 2 cm, with
+                       the simulator's objects; a block stacked where the expert stacks one
+                       is a step of the task, not a drop)
     goal_in_collision, ik_failed, no_path, start_in_collision, outside_workspace, invalid_pose,
     approach_blocked   the planner found no trajectory (plan-path's failure; its timeout, no
                        path within the time budget, counts as no_path)
@@ -75,6 +77,7 @@ NEAR_M = 0.04  # from a group of points (streams without objects)
 MARGIN_M = 0.02  # around an object's bounding box (with the simulator's objects)
 HOLDING_M = 0.001  # fingers closed this far apart or more stopped on something (streams without objects.held)
 PUSHED_M = 0.01  # an object moved this far by the move that closed the gripper on nothing: pushed
+PLACED_M = 0.02  # a target let go this near where the expert let one go on the scene was put down, not dropped
 
 
 def scalar(record, name, default=None):
@@ -221,9 +224,31 @@ def holds_something(observations):
     return any(held_role(o) is not None for o in observations)
 
 
-def reason(episode, kind, grasping=True):
+def released_at(before, after):
+    """Where the target the gripper holds in `before` lies in `after`, the observation after it
+    opened (None for streams without the simulator's objects)."""
+    was, now = scene_objects(before), scene_objects(after)
+    if not was or not now or [o.name for o in was] != [o.name for o in now]:
+        return None
+    return next((np.asarray(b.pose[:3], dtype=float) for a, b in zip(was, now) if a.held and a.role == "target"), None)
+
+
+def placements(observations):
+    """Where an episode (the expert's) let go of each target it held: the positions they lay at
+    in the next observation."""
+    found, holding = [], held_role(observations[0])
+    for before, after in zip(observations, observations[1:]):
+        now = held_role(after)
+        if holding == "target" and now is None and (at := released_at(before, after)) is not None:
+            found.append(at)
+        holding = now
+    return found
+
+
+def reason(episode, kind, grasping=True, placed=()):
     """The episode's reason (REASONS; see the module's text), given its kind (classify());
-    grasping: whether the task needs a grasp (an empty one is then a grasp_missed)."""
+    grasping: whether the task needs a grasp (an empty one is then a grasp_missed); placed:
+    where the expert let go of targets on the scene (placements()), releases there are no drop."""
     observations = episode["obs"]
     if int(scalar(observations[-1], "success", 0)):
         return "success"
@@ -241,7 +266,9 @@ def reason(episode, kind, grasping=True):
             elif grasping:
                 pending.append("pushed" if shifted(before, after) else "grasp_missed")
         elif holding == "target" and now is None:
-            pending.append("dropped")
+            at = released_at(before, after)
+            if at is None or not any(np.linalg.norm(at - p) <= PLACED_M for p in placed):
+                pending.append("dropped")
         failure = scalar(after, "failure", "")
         if failure:
             pending.append(action_reason(failure))
@@ -272,14 +299,16 @@ def main():
             if int(scalar(e[0], "episode_seed")) != int(scalar(a["obs"][0], "episode_seed")):
                 sys.exit("the expert's and the agent's episodes are not of the same scenes (episode_seed differs)")
         results = [classify(e, a) for e, a in zip(experts, agent)]
-    reasons = [reason(a, kind, e is None or holds_something(e)) for a, (kind, _, _), e in zip(agent, results, experts)]
+    reasons = [reason(a, kind, e is None or holds_something(e), placements(e) if e is not None else ())
+               for a, (kind, _, _), e in zip(agent, results, experts)]
     if args.episodes:
         for i, ((kind, distance, failure), why, expert) in enumerate(zip(results, reasons, experts)):
             line = (f"episode {i}: {why} ({kind}, {100 * distance:.1f} cm from the nearest object; "
                     f"{failure or 'no failure'})")
             if expert is not None and task_objects(expert[0]) is not None:
                 expert_episode = {"obs": expert, "actions": []}
-                line += f"; the expert: {reason(expert_episode, classify_by_poses(task_objects(expert[0]), expert_episode)[0])}"
+                expert_kind = classify_by_poses(task_objects(expert[0]), expert_episode)[0]
+                line += f"; the expert: {reason(expert_episode, expert_kind, placed=placements(expert))}"
             print(line, file=sys.stderr)
     kinds = Counter(kind for kind, _, _ in results)
     counts = Counter(reasons)

@@ -5,8 +5,9 @@ it documents: success; a distractor (the object it went for is not the expert's)
 missed; elsewhere (over 4 cm from every object); the first closing pose decides a grasp; and a
 table without objects. Then each reason from observations written before objects.held (what
 the fingers stopped on): the first cause, one made good by a later grasp, a lookalike before
-all, every failure name mapped. (tests/tools/test_failure_reasons_run.sh: the reasons on a real
-scene.) Run with Debian's python3 (NumPy)."""
+all, every failure name mapped; a target let go where the expert let one go is no drop.
+(tests/tools/test_failure_reasons_run.sh: the reasons on a real scene.) Run with Debian's
+python3 (NumPy)."""
 import os
 import sys
 
@@ -148,6 +149,30 @@ for want, moved, dx, role in [("pushed", 0, 0.03, 1), ("pushed", 1, -0.02, 1), (
     if got != want:
         failures.append(f"object {moved} (role {role}) moved {100 * dx:+.1f} cm by a grasp on nothing: expected {want}, got {got}")
 
+# A target let go where the expert let one go on the scene (within 2 cm) was put down, not
+# dropped: a block stacked as the expert stacks it, then a grasp that misses, is a grasp_missed.
+def release(block_at):
+    holding, opened = with_objects((0.3, 0.3), [1, 0]), with_objects((0.3, 0.3), [0, 0])
+    opened.fields["gripper_open"] = np.array(1, np.uint8)
+    opened.fields["objects.pose"] = opened.fields["objects.pose"].copy()
+    opened.fields["objects.pose"][0, :3] = block_at
+    return [holding, opened]
+
+
+stacked = np.array([0.2, 0.0, TABLE + 0.075])
+missed_after = with_objects((0.1, 0.1), [0, 0])  # closed on nothing, the stacked block where it was
+missed_after.fields["objects.pose"] = missed_after.fields["objects.pose"].copy()
+missed_after.fields["objects.pose"][0, :3] = stacked
+if [list(p) for p in fr.placements([step()] + release(stacked))] != [list(stacked)]:
+    failures.append(f"placements: expected [{list(stacked)}], got {fr.placements([step()] + release(stacked))}")
+for want, block_at, after in [("out_of_steps", stacked + [0.01, 0.01, 0], []), ("dropped", stacked + [0.03, 0, 0], []),
+                              ("dropped", stacked - [0, 0, 0.05], []), ("grasp_missed", stacked, [missed_after])]:
+    got = fr.reason({"obs": [step()] + release(block_at) + after, "actions": []}, "target", placed=[stacked])
+    if got != want:
+        failures.append(f"a block let go {100 * np.linalg.norm(block_at - stacked):.1f} cm from the expert's: expected {want}, got {got}")
+if fr.reason({"obs": [step()] + release(stacked), "actions": []}, "target") != "dropped":
+    failures.append("a release with no expert placement to match is not dropped")
+
 if failures:
     sys.exit("FAIL: " + "; ".join(failures))
-print(f"failure reasons ok: {len(cases) + 1} episodes sorted as the rule says, {len(reason_cases) + 1} reasons")
+print(f"failure reasons ok: {len(cases) + 1} episodes sorted as the rule says, {len(reason_cases) + 1} reasons, releases by the expert's placements")
