@@ -62,8 +62,8 @@ static cli::Usage usage() {
       "rotation and gripper head agrees with the batches' own actions: agree_rotation_x, _y, "
       "_z and agree_gripper, the share of samples whose greedy bin is the transition's, and "
       "loss_rotation, the mean Huber loss of the rotation terms; on demonstrations alone these "
-      "say whether the head fits them); a progress line goes to standard error. A non-finite loss stops the run with the step and the "
-      "records of the batch; the last checkpoint stays the last good one. Transitions of "
+      "say whether the head fits them); a progress line goes to standard error. A non-finite "
+      "loss stops the run with the step and the records of the batch; the last checkpoint stays the last good one. Transitions of "
       "another voxel size, depth count or grid edge (keyframed with another --offset or "
       "scene) are refused with their position.",
       "Architectures: 'light' (default; plain 3x3x3 convolutions, 16 base channels, about 0.25 "

@@ -299,16 +299,17 @@ def main():
             if int(scalar(e[0], "episode_seed")) != int(scalar(a["obs"][0], "episode_seed")):
                 sys.exit("the expert's and the agent's episodes are not of the same scenes (episode_seed differs)")
         results = [classify(e, a) for e, a in zip(experts, agent)]
-    reasons = [reason(a, kind, e is None or holds_something(e), placements(e) if e is not None else ())
-               for a, (kind, _, _), e in zip(agent, results, experts)]
+    placed = [placements(e) if e is not None else () for e in experts]  # the expert's, per scene
+    reasons = [reason(a, kind, e is None or holds_something(e), p)
+               for a, (kind, _, _), e, p in zip(agent, results, experts, placed)]
     if args.episodes:
-        for i, ((kind, distance, failure), why, expert) in enumerate(zip(results, reasons, experts)):
+        for i, ((kind, distance, failure), why, expert, expert_placed) in enumerate(zip(results, reasons, experts, placed)):
             line = (f"episode {i}: {why} ({kind}, {100 * distance:.1f} cm from the nearest object; "
                     f"{failure or 'no failure'})")
             if expert is not None and task_objects(expert[0]) is not None:
                 expert_episode = {"obs": expert, "actions": []}
                 expert_kind = classify_by_poses(task_objects(expert[0]), expert_episode)[0]
-                line += f"; the expert: {reason(expert_episode, expert_kind, placed=placements(expert))}"
+                line += f"; the expert: {reason(expert_episode, expert_kind, placed=expert_placed)}"
             print(line, file=sys.stderr)
     kinds = Counter(kind for kind, _, _ in results)
     counts = Counter(reasons)
