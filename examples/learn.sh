@@ -92,7 +92,7 @@ if [ "${3:-}" = --part ]; then
       exec qattn-train --follow --resume --stop-file "$run/actor.done" --replay-ratio "$RATIO" --pretrain "$PRETRAIN" \
         --start-after "$START_AFTER" --steps 1000000 --checkpoint-every "$CHECKPOINT_EVERY" --keep 4 \
         --architecture "$ARCH" $NET_OPTIONS --batch "$BATCH" --tree-target "$TARGET_K" $(branching "$TARGET_K") \
-        --n-step "$N_STEP" --demo-margin "$DEMO_MARGIN" --demo-cross-entropy "$DEMO_CROSS_ENTROPY" --head-input "$HEAD_INPUT" --seed "$SEED" --threads "$LEARNER_THREADS" \
+        --n-step "$N_STEP" --demo-margin "$DEMO_MARGIN" --demo-cross-entropy "$DEMO_CROSS_ENTROPY" --demo-share "$DEMO_SHARE" --head-input "$HEAD_INPUT" --seed "$SEED" --threads "$LEARNER_THREADS" \
         --precision "$PRECISION" --checkpoint-dir "$run/ckpt" --metrics "$run/train.csv" "${inputs[@]}" 2>> "$run/train.log" ;;
     # Actor I from chunk FIRST: a closed loop through a FIFO, up until its gate says stop,
     # running chunks FIRST, FIRST + ACTORS, ... of CHUNK_EPISODES exploring episodes as

@@ -56,6 +56,11 @@ std::vector<cli::OptionSpec> learner_config_options() {
                        "our variation: W times the cross-entropy of the rotation and gripper head's Q values "
                        "against the demonstrated bins, on the demonstrations (0: none, as published)",
                        default_text(d.demo_cross_entropy), 0, 1e3),
+      cli::real_option("demo-share", "F",
+                       "our variation: a share F of each batch from the demonstrations, the rest from the "
+                       "agent's transitions, each part prioritised within its kind (0: one draw over all, as "
+                       "published)",
+                       default_text(d.demo_share), 0, 1),
   };
 }
 
@@ -81,6 +86,7 @@ LearnerConfig learner_config_from(const cli::Arguments& args) {
   config.n_step = static_cast<int>(args.integer("n-step"));
   config.demo_margin = args.real("demo-margin");
   config.demo_cross_entropy = args.real("demo-cross-entropy");
+  config.demo_share = args.real("demo-share");
   config.validate();
   config.check_memory(static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE)));
   return config;

@@ -26,6 +26,7 @@ std::string LearnerConfig::json() const {
     << ", \"tree_target_k\": " << tree_target_k << ", \"n_step\": " << n_step;
   if (demo_margin > 0) s << ", \"demo_margin\": " << demo_margin;  // only then: older checkpoints still resume
   if (demo_cross_entropy > 0) s << ", \"demo_cross_entropy\": " << demo_cross_entropy;  // likewise
+  if (demo_share > 0) s << ", \"demo_share\": " << demo_share;  // likewise
   if (net.head_input != nets::HeadInput::pooled)  // only then, likewise
     s << ", \"head_input\": \"" << nets::head_input_name(net.head_input) << "\"";
   if (tree_branching.adaptive())  // only then: checkpoints from before adaptive K still resume
@@ -52,6 +53,7 @@ void LearnerConfig::validate() const {
       {"n-step", static_cast<double>(n_step)},
       {"demo-margin", demo_margin},
       {"demo-cross-entropy", demo_cross_entropy},
+      {"demo-share", demo_share},
   };
   for (const auto& [name, value] : values) cli::check_range(options, name, value, "the learner's settings");
   if (net.head_input == nets::HeadInput::voxel && net.architecture != nets::Architecture::light)

@@ -41,6 +41,12 @@ struct LearnerConfig {
   // which bin the demonstration took where the TD loss only raises that bin's Q. 0: none, as
   // published.
   double demo_cross_entropy = 0;
+  // Our variation: a share F of each batch drawn from the demonstrations' transitions and the
+  // rest from the agent's, each part prioritised within its kind (ReplayBuffer::sample), once
+  // the replay holds both. It keeps what the demonstrations teach at a fixed weight through the
+  // online phase, where the agent's transitions soon outnumber them. 0: one prioritised draw
+  // over all transitions, as published.
+  double demo_share = 0;
 
   // The settings a resumed run must share with its checkpoint, as JSON.
   std::string json() const;

@@ -235,7 +235,8 @@ void TrainingLoop::train() {
       continue;
     }
     std::mt19937_64 rng(derive_seed(options_.seed, static_cast<uint64_t>(step)));
-    const replay::Sample sample = replay_.sample(static_cast<std::size_t>(learner_.config().batch), options_.beta, rng);
+    const replay::Sample sample = replay_.sample(static_cast<std::size_t>(learner_.config().batch), options_.beta, rng,
+                                                 learner_.config().demo_share);
     const Minibatch batch = assemble_minibatch(replay_, sample, learner_.config());
     StepStats stats;
     try {

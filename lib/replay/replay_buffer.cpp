@@ -15,7 +15,8 @@ std::size_t cloud_size_bytes(const voxels::ObservationCloud& cloud) {
 
 }  // namespace
 
-ReplayBuffer::ReplayBuffer(ReplayOptions options) : options_(options), tree_(options.capacity) {
+ReplayBuffer::ReplayBuffer(ReplayOptions options)
+    : options_(options), tree_(options.capacity), demo_tree_(options.capacity), agent_tree_(options.capacity) {
   if (options_.capacity == 0) throw Error("replay capacity must be at least 1");
 }
 
@@ -65,8 +66,15 @@ bool ReplayBuffer::add(const stream::Record& record) {
   acting_on_[{stored.frame, stored.step}] = slot;
   if (slot == transitions_.size()) transitions_.push_back(std::move(stored));
   else transitions_[slot] = std::move(stored);
-  tree_.set(slot, options_.prioritised ? tree_.max() : 1.0);  // new: sampled at least once soon
+  set_priority(slot, options_.prioritised ? tree_.max() : 1.0);  // new: sampled at least once soon
   return true;
+}
+
+void ReplayBuffer::set_priority(std::size_t index, double priority) {
+  tree_.set(index, priority);
+  const bool demo = transitions_[index].demo;
+  (demo ? demo_tree_ : agent_tree_).set(index, priority);
+  (demo ? agent_tree_ : demo_tree_).set(index, 0.0);  // a slot may change kind when an agent's is replaced
 }
 
 void ReplayBuffer::release(const FrameKey& key) {
@@ -99,37 +107,49 @@ std::shared_ptr<const voxels::ObservationCloud> ReplayBuffer::next_cloud_of(std:
   return cloud_of_frame(transitions_.at(index).next_frame);
 }
 
-Sample ReplayBuffer::sample(std::size_t batch, double beta, std::mt19937_64& rng) const {
+Sample ReplayBuffer::sample(std::size_t batch, double beta, std::mt19937_64& rng, double demo_share) const {
   if (transitions_.empty()) throw Error("cannot sample from an empty replay");
   Sample s;
-  const double n = static_cast<double>(transitions_.size());
-  if (!options_.prioritised) {
+  const std::size_t agents = transitions_.size() - demos_;
+  if (demo_share > 0 && demos_ > 0 && agents > 0) {
+    const auto from_demos = static_cast<std::size_t>(std::lround(demo_share * static_cast<double>(batch)));
+    draw(demo_tree_, from_demos, demos_, beta, rng, s);
+    draw(agent_tree_, batch - from_demos, agents, beta, rng, s);
+  } else if (!options_.prioritised) {
     std::uniform_int_distribution<std::size_t> pick(0, transitions_.size() - 1);
     for (std::size_t i = 0; i < batch; ++i) s.indices.push_back(pick(rng));
     s.weights.assign(batch, 1.0);
     return s;
+  } else {
+    draw(tree_, batch, transitions_.size(), beta, rng, s);
   }
-  // Stratified: one draw per equal slice of the total priority mass.
-  const double total = tree_.total(), slice = total / batch;
-  for (std::size_t i = 0; i < batch; ++i) {
-    const double mass = std::min(total * (1 - 1e-12), (i + std::uniform_real_distribution<double>(0, 1)(rng)) * slice);
-    s.indices.push_back(std::min(tree_.find(mass), transitions_.size() - 1));
+  if (!options_.prioritised) {
+    s.weights.assign(s.indices.size(), 1.0);
+    return s;
   }
-  double max_weight = 0;
-  for (std::size_t index : s.indices) {
-    const double p = tree_.get(index) / total;
-    s.weights.push_back(std::pow(n * p, -beta));
-    max_weight = std::max(max_weight, s.weights.back());
-  }
+  const double max_weight = *std::max_element(s.weights.begin(), s.weights.end());
   for (double& w : s.weights) w /= max_weight;
   return s;
+}
+
+// Stratified: one draw per equal slice of the kind's priority mass; weights (n P(i))^-beta
+// within the kind, not yet normalised.
+void ReplayBuffer::draw(const SumTree& kind, std::size_t count, std::size_t kind_size, double beta,
+                        std::mt19937_64& rng, Sample& into) const {
+  const double total = kind.total(), slice = total / static_cast<double>(count), n = static_cast<double>(kind_size);
+  for (std::size_t i = 0; i < count; ++i) {
+    const double mass = std::min(total * (1 - 1e-12), (i + std::uniform_real_distribution<double>(0, 1)(rng)) * slice);
+    const std::size_t index = std::min(kind.find(mass), transitions_.size() - 1);
+    into.indices.push_back(index);
+    into.weights.push_back(std::pow(n * (kind.get(index) / total), -beta));  // as n * P(i), for the same bytes
+  }
 }
 
 void ReplayBuffer::update_priorities(const std::vector<std::size_t>& indices, const std::vector<double>& td_errors) {
   if (!options_.prioritised) return;
   for (std::size_t i = 0; i < indices.size(); ++i) {
     if (!std::isfinite(td_errors[i])) throw Error("non-finite TD error for transition " + std::to_string(indices[i]));
-    tree_.set(indices[i], std::pow(std::abs(td_errors[i]) + options_.priority_epsilon, options_.alpha));
+    set_priority(indices[i], std::pow(std::abs(td_errors[i]) + options_.priority_epsilon, options_.alpha));
   }
 }
 
@@ -145,7 +165,7 @@ void ReplayBuffer::restore_priorities(const std::vector<double>& priorities, dou
                 std::to_string(transitions_.size()) + " transitions");
   for (std::size_t i = 0; i < priorities.size(); ++i) {
     if (!(priorities[i] > 0) || !std::isfinite(priorities[i])) throw Error("replay: a priority is not positive");
-    tree_.set(i, priorities[i]);
+    set_priority(i, priorities[i]);
   }
   if (!(max_priority > 0) || !std::isfinite(max_priority)) throw Error("replay: the largest priority is not positive");
   tree_.restore_max(max_priority);

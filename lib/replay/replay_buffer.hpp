@@ -1,7 +1,8 @@
 // The learner's replay: frames (observations stored once) and the transitions that refer to
 // them, with prioritised sampling (priority = (|TD error| + eps)^alpha, importance weights
-// (N * P(i))^-beta normalised by their maximum) or uniform sampling. Demonstrations are kept
-// for good; when full, the oldest of the agent's own transitions makes room.
+// (N * P(i))^-beta normalised by their maximum) or uniform sampling, over all transitions or
+// with a fixed share of each batch from the demonstrations. Demonstrations are kept for good;
+// when full, the oldest of the agent's own transitions makes room.
 #pragma once
 
 #include <cstdint>
@@ -46,7 +47,11 @@ class ReplayBuffer {
   std::size_t demo_count() const { return demos_; }
   std::size_t frame_count() const { return frames_.size(); }
 
-  Sample sample(std::size_t batch, double beta, std::mt19937_64& rng) const;
+  // One draw over all transitions; or, with demo_share > 0 while the replay holds both kinds,
+  // round(demo_share * batch) of the batch from the demonstrations and the rest from the
+  // agent's transitions (demonstrations first), each part sampled and importance-weighted
+  // within its own kind as if it were a replay of its own; weights normalised over the batch.
+  Sample sample(std::size_t batch, double beta, std::mt19937_64& rng, double demo_share = 0) const;
   void update_priorities(const std::vector<std::size_t>& indices, const std::vector<double>& td_errors);
   double priority(std::size_t index) const { return tree_.get(index); }
   // Every transition's priority, in index order, and back (a learner's checkpoint).
@@ -80,6 +85,9 @@ class ReplayBuffer {
     bool demo = false;
   };
   void release(const FrameKey& key);
+  void set_priority(std::size_t index, double priority);
+  void draw(const SumTree& kind, std::size_t count, std::size_t kind_size, double beta, std::mt19937_64& rng,
+            Sample& into) const;
   std::shared_ptr<const voxels::ObservationCloud> cloud_of_frame(const FrameKey& key) const;
 
   ReplayOptions options_;
@@ -90,6 +98,8 @@ class ReplayBuffer {
   mutable std::size_t cloud_bytes_ = 0;
   std::map<ChainKey, std::size_t> acting_on_;  // the newest transition acting on each frame at each step
   SumTree tree_;
+  // The same priorities split by kind, each zero at the other kind's slots (for demo_share).
+  SumTree demo_tree_, agent_tree_;
   std::size_t demos_ = 0;
   std::size_t next_evicted_ = 0;  // ring position among the agent's transitions
 };

@@ -189,6 +189,79 @@ TEST(ReplayBuffer, ImportanceWeightsAreOneOverRootPNormalisedByTheBatchMaximum) 
   }
 }
 
+// --demo-share: a fixed part of each batch from the demonstrations, the rest from the agent's
+// transitions, each part sampled in proportion to its own kind's priorities and weighted as a
+// replay of that kind alone, (n_kind P_kind(i))^-beta, over the batch's largest: written out
+// here from the priorities themselves.
+TEST(ReplayBuffer, ADemoShareDrawsItsPartOfEachBatchFromTheDemonstrationsByTheirOwnPriorities) {
+  ReplayBuffer replay;
+  add_episode(replay, 1, 3, true);   // indices 0-2: demonstrations
+  add_episode(replay, 2, 5, false);  // 3-7: the agent's
+  replay.update_priorities({0, 1, 2, 3, 4, 5, 6, 7}, {0.2, 1.0, 3.0, 0.1, 0.1, 0.5, 2.0, 6.0});
+  const std::vector<double> p = replay.priorities();
+  const double demo_mass = p[0] + p[1] + p[2], agent_mass = p[3] + p[4] + p[5] + p[6] + p[7];
+  std::mt19937_64 rng(11);
+  std::vector<int> counts(8, 0);
+  const int rounds = 4000;
+  for (int round = 0; round < rounds; ++round) {
+    const Sample s = replay.sample(8, 0.5, rng, 0.25);
+    ASSERT_EQ(s.indices.size(), 8u);
+    double largest = 0;
+    std::vector<double> unnormalised;
+    for (std::size_t i = 0; i < 8; ++i) {
+      const std::size_t index = s.indices[i];
+      EXPECT_EQ(index < 3, i < 2) << "draw " << i << " of the batch is index " << index;  // 2 of 8 demos, first
+      const double w = index < 3 ? 1 / std::sqrt(3 * p[index] / demo_mass) : 1 / std::sqrt(5 * p[index] / agent_mass);
+      unnormalised.push_back(w);
+      largest = std::max(largest, w);
+      counts[index] += 1;
+    }
+    for (std::size_t i = 0; i < 8; ++i) EXPECT_NEAR(s.weights[i], unnormalised[i] / largest, 1e-12);
+  }
+  for (int i = 0; i < 8; ++i) {
+    const double expected = i < 3 ? 2.0 * rounds * p[i] / demo_mass : 6.0 * rounds * p[i] / agent_mass;
+    EXPECT_NEAR(counts[i], expected, 0.05 * expected + 30) << "index " << i;
+  }
+}
+
+// While the replay holds one kind only (pretraining: demonstrations), a share draws as one draw
+// over all: the same indices and weights, so a run's pretraining does not depend on it.
+TEST(ReplayBuffer, ADemoShareOverOneKindIsTheOneDrawOverAll) {
+  ReplayBuffer replay;
+  add_episode(replay, 1, 6, true);
+  replay.update_priorities({0, 1, 2, 3, 4, 5}, {0.1, 0.5, 1.0, 2.0, 4.0, 8.0});
+  std::mt19937_64 plain(7), shared(7);
+  for (int round = 0; round < 20; ++round) {
+    const Sample a = replay.sample(4, 0.5, plain), b = replay.sample(4, 0.5, shared, 0.5);
+    EXPECT_EQ(a.indices, b.indices);
+    EXPECT_EQ(a.weights, b.weights);
+  }
+}
+
+// A resumed replay samples its parts as the one never stopped: the kinds' priorities come back
+// with the checkpoint's, including a slot that changed kind (an agent's replaced by a demo's).
+TEST(ReplayBuffer, RestoredPrioritiesDrawTheSameDemoShare) {
+  ReplayOptions options;
+  options.capacity = 5;
+  ReplayBuffer straight(options), resumed(options);
+  for (ReplayBuffer* r : {&straight, &resumed}) {
+    add_episode(*r, 1, 2, true);
+    add_episode(*r, 2, 3, false);  // full
+    add_episode(*r, 3, 1, true);   // replaces the agent's oldest, index 2
+  }
+  EXPECT_EQ(straight.demo_count(), 3u);
+  straight.update_priorities({0, 1, 2, 3, 4}, {0.3, 2.0, 5.0, 0.2, 1.0});
+  resumed.restore_priorities(straight.priorities(), straight.max_priority());
+  std::mt19937_64 a(9), b(9);
+  for (int round = 0; round < 20; ++round) {
+    const Sample x = straight.sample(6, 0.5, a, 0.5), y = resumed.sample(6, 0.5, b, 0.5);
+    EXPECT_EQ(x.indices, y.indices);
+    EXPECT_EQ(x.weights, y.weights);
+    for (int i = 0; i < 3; ++i) EXPECT_LT(x.indices[i], 3u) << "0-2 are the demonstrations";
+    for (int i = 3; i < 6; ++i) EXPECT_GE(x.indices[i], 3u) << "3 and 4 are the agent's";
+  }
+}
+
 // New transitions start at the largest priority ever set: a resumed replay restores it, so a
 // transition added after the resume is sampled as in the run that was never stopped.
 TEST(ReplayBuffer, RestoredPrioritiesKeepTheLargestEverForNewTransitions) {
