@@ -112,7 +112,8 @@ Sample ReplayBuffer::sample(std::size_t batch, double beta, std::mt19937_64& rng
   Sample s;
   const std::size_t agents = transitions_.size() - demos_;
   if (demo_share > 0 && demos_ > 0 && agents > 0) {
-    const auto from_demos = static_cast<std::size_t>(std::lround(demo_share * static_cast<double>(batch)));
+    const auto from_demos =
+        std::min(batch, static_cast<std::size_t>(std::lround(demo_share * static_cast<double>(batch))));
     draw(demo_tree_, from_demos, demos_, beta, rng, s);
     draw(agent_tree_, batch - from_demos, agents, beta, rng, s);
   } else if (!options_.prioritised) {
@@ -127,6 +128,7 @@ Sample ReplayBuffer::sample(std::size_t batch, double beta, std::mt19937_64& rng
     s.weights.assign(s.indices.size(), 1.0);
     return s;
   }
+  if (s.weights.empty()) return s;
   const double max_weight = *std::max_element(s.weights.begin(), s.weights.end());
   for (double& w : s.weights) w /= max_weight;
   return s;

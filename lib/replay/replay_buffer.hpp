@@ -51,6 +51,7 @@ class ReplayBuffer {
   // round(demo_share * batch) of the batch from the demonstrations and the rest from the
   // agent's transitions (demonstrations first), each part sampled and importance-weighted
   // within its own kind as if it were a replay of its own; weights normalised over the batch.
+  // (A uniform replay's parts are then stratified over their kind, all weights 1.)
   Sample sample(std::size_t batch, double beta, std::mt19937_64& rng, double demo_share = 0) const;
   void update_priorities(const std::vector<std::size_t>& indices, const std::vector<double>& td_errors);
   double priority(std::size_t index) const { return tree_.get(index); }

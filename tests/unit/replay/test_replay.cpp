@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <tuple>
 
 #include "replay/growing_stream.hpp"
 #include "replay/replay_buffer.hpp"
@@ -224,17 +225,37 @@ TEST(ReplayBuffer, ADemoShareDrawsItsPartOfEachBatchFromTheDemonstrationsByTheir
   }
 }
 
-// While the replay holds one kind only (pretraining: demonstrations), a share draws as one draw
-// over all: the same indices and weights, so a run's pretraining does not depend on it.
-TEST(ReplayBuffer, ADemoShareOverOneKindIsTheOneDrawOverAll) {
+// The demonstrations' part is the share of the batch rounded to the nearest draw, and all of it
+// at a share of 1.
+TEST(ReplayBuffer, ADemoShareRoundsToTheNearestDraw) {
   ReplayBuffer replay;
-  add_episode(replay, 1, 6, true);
-  replay.update_priorities({0, 1, 2, 3, 4, 5}, {0.1, 0.5, 1.0, 2.0, 4.0, 8.0});
-  std::mt19937_64 plain(7), shared(7);
-  for (int round = 0; round < 20; ++round) {
-    const Sample a = replay.sample(4, 0.5, plain), b = replay.sample(4, 0.5, shared, 0.5);
-    EXPECT_EQ(a.indices, b.indices);
-    EXPECT_EQ(a.weights, b.weights);
+  add_episode(replay, 1, 2, true);
+  add_episode(replay, 2, 2, false);
+  std::mt19937_64 rng(13);
+  for (const auto& [batch, share, demos] : {std::tuple<std::size_t, double, std::size_t>{3, 0.5, 2}, {3, 0.1, 0},
+                                            {5, 0.3, 2}, {4, 1.0, 4}, {1, 0.5, 1}}) {
+    const Sample s = replay.sample(batch, 0.5, rng, share);
+    ASSERT_EQ(s.indices.size(), batch);
+    std::size_t from_demos = 0;
+    for (std::size_t index : s.indices) from_demos += index < 2;
+    EXPECT_EQ(from_demos, demos) << "batch " << batch << ", share " << share;
+  }
+}
+
+// While the replay holds one kind only (pretraining: demonstrations; or the agent's alone), a
+// share draws as one draw over all: the same indices and weights, so a run's pretraining does
+// not depend on it.
+TEST(ReplayBuffer, ADemoShareOverOneKindIsTheOneDrawOverAll) {
+  for (const bool demo : {true, false}) {
+    ReplayBuffer replay;
+    add_episode(replay, 1, 6, demo);
+    replay.update_priorities({0, 1, 2, 3, 4, 5}, {0.1, 0.5, 1.0, 2.0, 4.0, 8.0});
+    std::mt19937_64 plain(7), shared(7);
+    for (int round = 0; round < 20; ++round) {
+      const Sample a = replay.sample(4, 0.5, plain), b = replay.sample(4, 0.5, shared, 0.5);
+      EXPECT_EQ(a.indices, b.indices);
+      EXPECT_EQ(a.weights, b.weights);
+    }
   }
 }
 
