@@ -38,7 +38,8 @@ def agent_actions(path, step):
                          "(run sim-step with --objects)")
             positions = np.array([o.pose[:3] for o in objects], dtype=float).reshape(-1, 3)
             yaws = [yaw_deg(o.pose[3:7]) for o in objects]
-            episodes.append(([o.name for o in objects], positions, yaws, record.fields))
+            targets = [o.role == "target" for o in objects]
+            episodes.append(([o.name for o in objects], positions, yaws, record.fields, targets))
     return episodes
 
 
@@ -65,7 +66,7 @@ def demonstrated(path, step):
 
 
 def rows(episodes, demos):
-    for i, (names, positions, yaws, action) in enumerate(episodes):
+    for i, (names, positions, yaws, action, targets) in enumerate(episodes):
         pose = np.asarray(action["pose"], dtype=float)
         distances = [float(np.linalg.norm(pose[:2] - p[:2])) for p in positions]
         nearest = int(np.argmin(distances)) if names else None
@@ -75,6 +76,8 @@ def rows(episodes, demos):
                "rotation_bins": " ".join(str(int(b)) for b in action["rotation_bins"]),
                "gripper_open": int(action["gripper_open"])}
         row.update({f"cm_to_{n}": f"{100 * d:.1f}" for n, d in zip(names, distances)})
+        to_targets = [d for d, is_target in zip(distances, targets) if is_target]
+        row["cm_to_target"] = f"{100 * min(to_targets):.1f}" if to_targets else ""
         if demos is not None:
             d = demos[i]
             row["cm_to_demonstrated"] = f"{100 * np.linalg.norm(pose[:3] - np.asarray(d['target_pose'][:3])):.1f}"
@@ -107,8 +110,11 @@ def main(argv=None):
     counts = ", ".join(f"{n} {nearest.count(n)}" for n in dict.fromkeys(nearest))
     closed = sum(row["gripper_open"] == 0 for row in table)
     yaw_bins = sorted({int(row["rotation_bins"].split()[2]) for row in table})
+    to_target = [float(row["cm_to_target"]) for row in table if row["cm_to_target"]]
+    target = (f"; to the target: median {np.median(to_target):.1f} cm, within 3 cm in {sum(d < 3 for d in to_target)}"
+              if to_target else "")
     print(f"step {args.step}: {len(table)} episodes; nearest object: {counts}; gripper closed in {closed}; "
-          f"yaw bins {' '.join(map(str, yaw_bins))}", file=sys.stderr)
+          f"yaw bins {' '.join(map(str, yaw_bins))}{target}", file=sys.stderr)
 
 
 if __name__ == "__main__":

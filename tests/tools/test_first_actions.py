@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """examples/analysis/first_actions.py on streams made with stream-pack, its table against values
 worked out here by hand: the action of the asked step per episode, its distance to each object,
-the nearest and its yaw, the rotation bins, the gripper; with --demonstrations, the earliest frame's demonstrated transition of
+the nearest and its yaw, the rotation bins, the gripper, the distance to the target (the role-1
+object); with --demonstrations, the earliest frame's demonstrated transition of
 that step per episode key in file order; an agent stream without objects is refused."""
 import csv
 import io
@@ -68,19 +69,20 @@ with tempfile.TemporaryDirectory() as tmp:
         # Worked by hand: horizontal distances in cm; the demonstrated pose is (x, 0, 0.8).
         want = [
             {"episode": "0", "nearest": "base", "nearest_yaw_deg": "+0", "rotation_bins": "0 36 20",
-             "gripper_open": "0", "cm_to_base": "1.0", "cm_to_phone": "29.0",
+             "gripper_open": "0", "cm_to_base": "1.0", "cm_to_phone": "29.0", "cm_to_target": "29.0",
              "cm_to_demonstrated": "1.0", "depth0_agrees": "1", "rotation_agrees": "0",
              "demonstrated_rotation_bins": "0 36 21",
              "demonstrated_gripper_open": "1"},
             {"episode": "1", "nearest": "phone", "nearest_yaw_deg": "+60", "rotation_bins": "0 36 22",
-             "gripper_open": "1", "cm_to_base": "30.1", "cm_to_phone": "2.0",
+             "gripper_open": "1", "cm_to_base": "30.1", "cm_to_phone": "2.0", "cm_to_target": "2.0",
              "cm_to_demonstrated": "5.4", "depth0_agrees": "0", "rotation_agrees": "1",
              "demonstrated_rotation_bins": "0 36 22",
              "demonstrated_gripper_open": "1"},
         ]
         if table != want:
             failures.append(f"table:\n{table}\nwanted:\n{want}")
-        if "nearest object: base 1, phone 1; gripper closed in 1; yaw bins 20 22" not in r.stderr:
+        if ("nearest object: base 1, phone 1; gripper closed in 1; yaw bins 20 22; to the target: median 15.5 cm, "
+                "within 3 cm in 1") not in r.stderr:
             failures.append(f"summary: {r.stderr}")
 
     r = run("--step", "1", agent)
