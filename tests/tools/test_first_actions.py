@@ -2,7 +2,7 @@
 """examples/analysis/first_actions.py on streams made with stream-pack, its table against values
 worked out here by hand: the action of the asked step per episode, its distance to each object,
 the nearest and its yaw, the rotation bins, the gripper, the distance to the target (the role-1
-object); with --demonstrations, the earliest frame's demonstrated transition of
+object), depth 0's voxel and the chosen voxels' Q values; with --demonstrations, the earliest frame's demonstrated transition of
 that step per episode key in file order; an agent stream without objects is refused."""
 import csv
 import io
@@ -31,9 +31,9 @@ def obs(path, step, objects=True):
     pack(path, "obs", *fields)
 
 
-def action(path, step, x, y, gripper, d0="1,2,3", bins="0,36,20"):
+def action(path, step, x, y, gripper, d0="1,2,3", bins="0,36,20", q=("0.5", "0.25")):
     pack(path, "action", f"step:i32={step}", f"pose:f64={x},{y},0.8,0,0,0,1", f"gripper_open:u8={gripper}",
-         f"depth0.index:i32={d0}", f"rotation_bins:i32={bins}")
+         f"depth0.index:i32={d0}", f"rotation_bins:i32={bins}", f"depth0.q_value:f32={q[0]}", f"depth1.q_value:f32={q[1]}")
 
 
 def transition(path, key, frame, step, x, gripper, d0, bins):
@@ -52,7 +52,7 @@ with tempfile.TemporaryDirectory() as tmp:
     # phone, open. Each episode's step-1 action is not the asked step's.
     obs(agent, 0); action(agent, 0, 0.01, 0.0, 0, d0="7,5,4")
     obs(agent, 1); action(agent, 1, 0.3, 0.0, 1)
-    obs(agent, 0); action(agent, 0, 0.3, 0.02, 1, d0="9,9,4", bins="0,36,22")
+    obs(agent, 0); action(agent, 0, 0.3, 0.02, 1, d0="9,9,4", bins="0,36,22", q=("0.75", "-0.125"))
     # The phone is turned by +60 degrees (quaternion z = sin 30, w = cos 30), the base not.
     # Demonstrations: episode key 5 twice at step 0 (frames 4 and 0: frame 0 counts), key 9 once;
     # a step-1 transition of key 5 in between.
@@ -69,12 +69,14 @@ with tempfile.TemporaryDirectory() as tmp:
         # Worked by hand: horizontal distances in cm; the demonstrated pose is (x, 0, 0.8).
         want = [
             {"episode": "0", "nearest": "base", "nearest_yaw_deg": "+0", "rotation_bins": "0 36 20",
-             "gripper_open": "0", "cm_to_base": "1.0", "cm_to_phone": "29.0", "cm_to_target": "29.0",
+             "gripper_open": "0", "depth0_index": "7 5 4", "q_depth0": "0.5000", "q_depth1": "0.2500",
+             "cm_to_base": "1.0", "cm_to_phone": "29.0", "cm_to_target": "29.0",
              "cm_to_demonstrated": "1.0", "depth0_agrees": "1", "rotation_agrees": "0",
              "demonstrated_rotation_bins": "0 36 21",
              "demonstrated_gripper_open": "1"},
             {"episode": "1", "nearest": "phone", "nearest_yaw_deg": "+60", "rotation_bins": "0 36 22",
-             "gripper_open": "1", "cm_to_base": "30.1", "cm_to_phone": "2.0", "cm_to_target": "2.0",
+             "gripper_open": "1", "depth0_index": "9 9 4", "q_depth0": "0.7500", "q_depth1": "-0.1250",
+             "cm_to_base": "30.1", "cm_to_phone": "2.0", "cm_to_target": "2.0",
              "cm_to_demonstrated": "5.4", "depth0_agrees": "0", "rotation_agrees": "1",
              "demonstrated_rotation_bins": "0 36 22",
              "demonstrated_gripper_open": "1"},
