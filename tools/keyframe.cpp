@@ -28,7 +28,7 @@ static cli::Usage usage() {
       "as --chain-steps says. A transition's action is its "
       "next keyframe's gripper pose: the voxel index at every depth (depth d inside the grid "
       "centred on depth d-1's voxel, shifted by U(-0.75, 0.75) * offset per axis with crop "
-      "augmentation), rotation bins (Euler 'xyz', 72 bins of 5 degrees), gripper open/close, "
+      "augmentation; an --offset too small for the shift to keep the keyframe inside is refused), rotation bins (Euler 'xyz', 72 bins of 5 degrees), gripper open/close, "
       "ignore-collisions; reward 100 on the final transition of a successful episode, else 0.",
       "Observations are written once each as compact 'frame' records (RGB and depth in uint16 "
       "millimetres, zstd-compressed, camera matrices, proprioception) ahead of the 'transition' "

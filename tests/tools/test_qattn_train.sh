@@ -123,9 +123,9 @@ keyframe --voxels 8 --seed 1 "$tmp/demos.rec" > "$tmp/tr8.rec" 2>/dev/null
 err=$(train --steps 2 --checkpoint-dir "$tmp/v" "$tmp/tr8.rec" 2>&1) && fail "8-voxel transitions accepted"
 grep -q "tr8.rec: record [0-9]* at byte [0-9]*: 'transition' record, field 'voxels': expected 16 voxels" <<<"$err" || fail "$err"
 # Keyframed with another --offset: the learner's next-state grids would have other edges.
-keyframe --offset 0.1 --seed 1 "$tmp/demos.rec" > "$tmp/tr01.rec" 2>/dev/null
-err=$(train --steps 2 --checkpoint-dir "$tmp/o" "$tmp/tr01.rec" 2>&1) && fail "transitions of --offset 0.1 accepted"
-grep -q "tr01.rec: record [0-9]* at byte [0-9]*: 'transition' record, field 'depth1.bounds': expected a grid edge of 0.3 m, as the learner's --offset (2 x offset); the transition has 0.2 m" \
+keyframe --offset 0.2 --seed 1 "$tmp/demos.rec" > "$tmp/tr01.rec" 2>/dev/null
+err=$(train --steps 2 --checkpoint-dir "$tmp/o" "$tmp/tr01.rec" 2>&1) && fail "transitions of --offset 0.2 accepted"
+grep -q "tr01.rec: record [0-9]* at byte [0-9]*: 'transition' record, field 'depth1.bounds': expected a grid edge of 0.3 m, as the learner's --offset (2 x offset); the transition has 0.4 m" \
   <<<"$err" || fail "$err"
 # A fresh run that stops before it saved a trained checkpoint leaves nothing behind (its
 # initial checkpoint and metrics file are removed); one that saved trained checkpoints keeps them.

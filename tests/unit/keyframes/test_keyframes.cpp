@@ -299,3 +299,29 @@ TEST(Transitions, ChainStepsCountFromZeroOrFromTheKeyframesPassed) {
     if (chain_steps == ChainSteps::reset) EXPECT_EQ(chain_starts_at_zero, (std::set<int>{0, 10, 20, 30}));
   }
 }
+
+// Crop augmentation shifts depth d's grid by up to 0.75 of its half edge, and a keyframe lies up
+// to half of depth d-1's voxel from that voxel's centre: offsets too small for both are refused
+// (the keyframe would be clamped onto the grid's face), the published ones pass.
+TEST(Transitions, OffsetsTooSmallForCropAugmentationAreRefused) {
+  const auto converter_with = [](std::vector<double> offsets, bool crop) {
+    TransitionOptions options;
+    options.hierarchy.depths = static_cast<int>(offsets.size()) + 1;
+    options.hierarchy.offsets_m = offsets;
+    options.crop_augmentation = crop;
+    EpisodeConverter converter(options);
+  };
+  EXPECT_NO_THROW(converter_with({0.15}, true));        // 3.125 cm + 11.25 cm <= 15 cm
+  EXPECT_NO_THROW(converter_with({0.15, 0.05}, true));  // and 0.94 cm + 3.75 cm <= 5 cm at depth 2
+  EXPECT_NO_THROW(converter_with({0.05}, false));
+  EXPECT_NO_THROW(converter_with({0.125}, true));       // 3.125 + 9.375 = 12.5: just inside
+  try {
+    converter_with({0.05}, true);  // 3.125 cm + 3.75 cm > 5 cm
+    FAIL() << "a 5 cm half edge at depth 1 was accepted with crop augmentation";
+  } catch (const UsageError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("depth 1's half edge 0.05 m"), std::string::npos) << what;
+    EXPECT_NE(what.find("at least 0.125 m or --no-crop-augmentation"), std::string::npos) << what;
+  }
+  EXPECT_THROW(converter_with({0.15, 0.03}, true), UsageError);  // depth 2: 0.94 + 2.25 > 3 cm
+}
