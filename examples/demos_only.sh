@@ -9,7 +9,8 @@
 #        environment: SEED 0, DEMOS 10, IMAGE 256x256, STEPS 2000, N_STEP 3, VARIATION 0, CHAIN_STEPS reset
 #        (keyframe --chain-steps), KS "1 10" (the K the networks act with), DEMO_MARGIN 0
 #        (qattn-train --demo-margin), DEMO_CROSS_ENTROPY 0 (qattn-train --demo-cross-entropy),
-#        HEAD_INPUT pooled (qattn-train --head-input),
+#        HEAD_INPUT pooled (qattn-train --head-input), CROP_AUGMENTATION on (off: keyframe
+#        --no-crop-augmentation),
 #        NET_OPTIONS e.g. "--depths 3 --offset 0.15,0.05", PLAN_OPTIONS as learn.sh's; make -C
 #        examples demos-only, which sets PLAN_OPTIONS as the task's runs have it).
 # Writes OUT_DIR/failures-stepSTEPS-kK.csv; resumable (the learner resumes, finished CSVs stay).
@@ -17,13 +18,15 @@ set -euo pipefail
 task=$1 out=$2
 : "${SEED:=0}" "${DEMOS:=10}" "${IMAGE:=256x256}" "${STEPS:=2000}" "${N_STEP:=3}" "${VARIATION:=0}" "${NET_OPTIONS:=}"
 : "${CHAIN_STEPS:=reset}" "${KS:=1 10}" "${DEMO_MARGIN:=0}" "${DEMO_CROSS_ENTROPY:=0}" "${HEAD_INPUT:=pooled}"
+: "${CROP_AUGMENTATION:=on}"
+crop_option=; [ "$CROP_AUGMENTATION" = on ] || crop_option=--no-crop-augmentation
 here=$(cd "$(dirname "$0")" && pwd)
 source "$here/common.sh"
 mkdir -p "$out"
 if [ ! -f "$out/replay.rec" ]; then  # learn.sh's demonstrations for SEED, the same bytes
   demo-record --task "$task" --episodes "$DEMOS" --seed "$SEED" --scenes demo --variation "$VARIATION" --image-size "$IMAGE" \
     --compress --output "$out/demos.rec" 2> "$out/demos.log"
-  keyframe --seed "$SEED" --chain-steps "$CHAIN_STEPS" $NET_OPTIONS --output "$out/replay.rec.tmp" "$out/demos.rec" 2>> "$out/demos.log"
+  keyframe --seed "$SEED" --chain-steps "$CHAIN_STEPS" $crop_option $NET_OPTIONS --output "$out/replay.rec.tmp" "$out/demos.rec" 2>> "$out/demos.log"
   mv "$out/replay.rec.tmp" "$out/replay.rec"
 fi
 qattn-train --resume --steps "$STEPS" --start-after 0 --checkpoint-every 250 --keep 20 --architecture light --batch 32 \

@@ -149,7 +149,9 @@ fi
 # The settings its replay's demonstrations were made with likewise: replay.rec is made once, so
 # a run resumed with others (CHAIN_STEPS=episode into a reset run's directory, which has the same
 # label) would train on data it does not name.
+crop_option=; [ "$CROP_AUGMENTATION" = on ] || crop_option=--no-crop-augmentation
 demo_settings="DEMOS=$DEMOS IMAGE=$IMAGE VARIATION=$VARIATION CHAIN_STEPS=$CHAIN_STEPS DEMOS_FROM=$DEMOS_FROM NET_OPTIONS=$NET_OPTIONS"
+demo_settings+=${crop_option:+ CROP_AUGMENTATION=off}  # named only when off: earlier runs' files stay valid
 if [ -f "$run/demo_settings" ]; then
   [ "$(cat "$run/demo_settings")" = "$demo_settings" ] || {
     echo "learn.sh: $run was started with $(cat "$run/demo_settings"), not $demo_settings" >&2; exit 2; }
@@ -249,7 +251,7 @@ if [ ! -f "$run/replay.rec" ]; then
     demo-record --task "$task" --episodes "$DEMOS" --seed "$SEED" --scenes demo --variation "$VARIATION" --image-size "$IMAGE" \
       --compress --output "$run/demos.rec" 2>> "$run/demos.log"
   fi
-  keyframe --seed "$SEED" --chain-steps "$CHAIN_STEPS" $NET_OPTIONS --output "$run/replay.rec.tmp" "$run/demos.rec" 2>> "$run/demos.log"
+  keyframe --seed "$SEED" --chain-steps "$CHAIN_STEPS" $crop_option $NET_OPTIONS --output "$run/replay.rec.tmp" "$run/demos.rec" 2>> "$run/demos.log"
   mv "$run/replay.rec.tmp" "$run/replay.rec"
   demos_ticks=$(( $(shell_ticks) - before ))
 fi

@@ -32,6 +32,7 @@ refused "EVAL_EPISODES=0|at least 1" -- EVAL_EPISODES=0
 refused "EPSILON=1.5|from 0 to 1" -- EPSILON=1.5
 refused "METHOD=qtee|one of qte, c2farm, adaptive" -- METHOD=qtee
 refused "IMAGE=128|WIDTHxHEIGHT" -- IMAGE=128
+refused "CROP_AUGMENTATION=no|one of on, off" -- CROP_AUGMENTATION=no
 task=reach_targe refused "reach_targe is not a task|reach_target" -- SEED=0
 # Names of the system that are near no setting pass (the shell's, make's); so do settings.
 HOME_DIR=x LANGUAGE=en ASAN_OPTIONS=x LSAN_OPTIONS=x TSAN_OPTIONS=x bash -c ". '$src/examples/common.sh'; . '$src/examples/settings.sh'; settings_load test" \
