@@ -251,7 +251,8 @@ if [ ! -f "$run/replay.rec" ]; then
     demo-record --task "$task" --episodes "$DEMOS" --seed "$SEED" --scenes demo --variation "$VARIATION" --image-size "$IMAGE" \
       --compress --output "$run/demos.rec" 2>> "$run/demos.log"
   fi
-  keyframe --seed "$SEED" --chain-steps "$CHAIN_STEPS" $crop_option $NET_OPTIONS --output "$run/replay.rec.tmp" "$run/demos.rec" 2>> "$run/demos.log"
+  keyframe --seed "$SEED" --chain-steps "$CHAIN_STEPS" $crop_option $NET_OPTIONS --output "$run/replay.rec.tmp" "$run/demos.rec" 2>> "$run/demos.log" \
+    || { status=$?; echo "learn.sh: $(tail -1 "$run/demos.log")" >&2; exit "$status"; }  # its reason, not only in demos.log
   mv "$run/replay.rec.tmp" "$run/replay.rec"
   demos_ticks=$(( $(shell_ticks) - before ))
 fi
