@@ -58,6 +58,11 @@ finished_run_settings() {  # RUN
 # The learner's numbered checkpoints, DIR/step-NNNNNNNN.rec (qattn-train --checkpoint-dir DIR;
 # the program names them in CheckpointDirectory::path_for, lib/learner/training_files.cpp;
 # supervise.py finds the newest).
+# keyframe's option for the CROP_AUGMENTATION setting (VALUE on or off): none, or --no-crop-augmentation.
+crop_augmentation_option() {  # VALUE
+  [ "$1" = on ] || echo --no-crop-augmentation
+}
+
 checkpoint_path() {  # DIR STEP
   printf '%s/step-%08d.rec\n' "$1" "$2"
 }

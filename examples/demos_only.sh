@@ -19,9 +19,9 @@ task=$1 out=$2
 : "${SEED:=0}" "${DEMOS:=10}" "${IMAGE:=256x256}" "${STEPS:=2000}" "${N_STEP:=3}" "${VARIATION:=0}" "${NET_OPTIONS:=}"
 : "${CHAIN_STEPS:=reset}" "${KS:=1 10}" "${DEMO_MARGIN:=0}" "${DEMO_CROSS_ENTROPY:=0}" "${HEAD_INPUT:=pooled}"
 : "${CROP_AUGMENTATION:=on}"
-crop_option=; [ "$CROP_AUGMENTATION" = on ] || crop_option=--no-crop-augmentation
 here=$(cd "$(dirname "$0")" && pwd)
 source "$here/common.sh"
+crop_option=$(crop_augmentation_option "$CROP_AUGMENTATION")
 mkdir -p "$out"
 if [ ! -f "$out/replay.rec" ]; then  # learn.sh's demonstrations for SEED, the same bytes
   demo-record --task "$task" --episodes "$DEMOS" --seed "$SEED" --scenes demo --variation "$VARIATION" --image-size "$IMAGE" \

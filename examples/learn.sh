@@ -149,7 +149,7 @@ fi
 # The settings its replay's demonstrations were made with likewise: replay.rec is made once, so
 # a run resumed with others (CHAIN_STEPS=episode into a reset run's directory, which has the same
 # label) would train on data it does not name.
-crop_option=; [ "$CROP_AUGMENTATION" = on ] || crop_option=--no-crop-augmentation
+crop_option=$(crop_augmentation_option "$CROP_AUGMENTATION")
 demo_settings="DEMOS=$DEMOS IMAGE=$IMAGE VARIATION=$VARIATION CHAIN_STEPS=$CHAIN_STEPS DEMOS_FROM=$DEMOS_FROM NET_OPTIONS=$NET_OPTIONS"
 demo_settings+=${crop_option:+ CROP_AUGMENTATION=off}  # named only when off: earlier runs' files stay valid
 if [ -f "$run/demo_settings" ]; then

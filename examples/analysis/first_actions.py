@@ -77,9 +77,9 @@ def rows(episodes, demos):
                "gripper_open": int(action["gripper_open"])}
         if "depth0.index" in action:
             row["depth0_index"] = " ".join(str(int(v)) for v in action["depth0.index"])
-        for d in range(8):  # the chosen voxels' Q values, where the stream has them
-            if f"depth{d}.q_value" in action:
-                row[f"q_depth{d}"] = f"{float(np.asarray(action[f'depth{d}.q_value']).reshape(-1)[0]):.4f}"
+        for name in action:  # the chosen voxels' Q values, where the stream has them (depth<d>.q_value)
+            if name.startswith("depth") and name.endswith(".q_value"):
+                row[f"q_{name[:-len('.q_value')]}"] = f"{float(np.asarray(action[name]).reshape(-1)[0]):.4f}"
         row.update({f"cm_to_{n}": f"{100 * d:.1f}" for n, d in zip(names, distances)})
         to_targets = [d for d, is_target in zip(distances, targets) if is_target]
         row["cm_to_target"] = f"{100 * min(to_targets):.1f}" if to_targets else ""

@@ -18,6 +18,27 @@
 namespace qte::keyframes {
 namespace {
 
+// A keyframe lies within half a voxel of depth d-1's voxel centre (per axis), and crop
+// augmentation moves depth d's grid by up to a fraction f of its half edge: a grid too small
+// for both would miss the keyframe, whose index is then clamped to the grid's face, and train
+// depth d on a voxel the keyframe is not in. Throws UsageError then.
+void check_crop_augmentation(const TransitionOptions& options) {
+  if (!options.crop_augmentation) return;
+  const voxels::CoarseToFine& h = options.hierarchy;
+  const double f = options.crop_shift_fraction;
+  for (int d = 1; d < h.depths; ++d) {
+    const double half_voxel = 0.5 * h.bounds_at(d - 1, Eigen::Vector3d::Zero()).voxel_size_m();
+    if (half_voxel + f * h.offset_at(d) <= h.offset_at(d) * (1 + 1e-9)) continue;
+    std::ostringstream s;
+    s.precision(3);
+    s << "--offset: depth " << d << "'s half edge " << h.offset_at(d) << " m is too small for crop augmentation: "
+      << "its grid moves by up to " << f * h.offset_at(d) << " m and a keyframe lies up to " << half_voxel
+      << " m from depth " << d - 1 << "'s voxel centre, so it could fall outside the grid; use a half edge of at least "
+      << half_voxel / (1 - f) << " m or --no-crop-augmentation";
+    throw UsageError(s.str());
+  }
+}
+
 // FNV-1a: a stable 64-bit key for an episode from what identifies it.
 uint64_t fnv1a(const void* data, std::size_t n, uint64_t h = 1469598103934665603ull) {
   const auto* p = static_cast<const uint8_t*>(data);
@@ -181,27 +202,6 @@ stream::Record frame_record(const stream::Record& obs, int64_t episode_key) {
 
 EpisodeConverter::EpisodeConverter(TransitionOptions options) : options_(std::move(options)), rng_(options_.seed) {
   check_crop_augmentation(options_);
-}
-
-// A keyframe lies within half a voxel of depth d-1's voxel centre (per axis), and crop
-// augmentation moves depth d's grid by up to a fraction f of its half edge: a grid too small
-// for both would miss the keyframe, whose index is then clamped to the grid's face, and train
-// depth d on a voxel the keyframe is not in.
-void check_crop_augmentation(const TransitionOptions& options) {
-  if (!options.crop_augmentation) return;
-  const voxels::CoarseToFine& h = options.hierarchy;
-  const double f = options.crop_shift_fraction;
-  for (int d = 1; d < h.depths; ++d) {
-    const double half_voxel = 0.5 * (d == 1 ? h.scene.voxel_size_m() : 2 * h.offset_at(d - 1) / h.voxels());
-    if (half_voxel + f * h.offset_at(d) <= h.offset_at(d) * (1 + 1e-9)) continue;
-    std::ostringstream s;
-    s.precision(3);
-    s << "--offset: depth " << d << "'s half edge " << h.offset_at(d) << " m is too small for crop augmentation: "
-      << "its grid moves by up to " << f * h.offset_at(d) << " m and a keyframe lies up to " << half_voxel
-      << " m from depth " << d - 1 << "'s voxel centre, so it could fall outside the grid; use a half edge of at least "
-      << half_voxel / (1 - f) << " m or --no-crop-augmentation";
-    throw UsageError(s.str());
-  }
 }
 
 void EpisodeConverter::handle(const stream::Record& record, const stream::Emit& emit) {

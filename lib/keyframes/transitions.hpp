@@ -46,12 +46,10 @@ struct ConversionCounts {
   std::string summary() const;
 };
 
-// Throws UsageError when crop augmentation could move a deeper grid off its keyframe (the
-// hierarchy's offsets too small for options.crop_shift_fraction).
-void check_crop_augmentation(const TransitionOptions& options);
-
 class EpisodeConverter : public stream::Stage {
  public:
+  // Throws UsageError when crop augmentation could move a deeper grid off its keyframe (offsets
+  // too small for options.crop_shift_fraction).
   explicit EpisodeConverter(TransitionOptions options);
 
   // Feed a demonstration stream record by record: obs records gather into an episode, which
